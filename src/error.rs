@@ -1,0 +1,93 @@
+//! Errors. Every error that comes from input names the file, the line where there is one,
+//! and what is wrong, on one line (after pbrt-v4's `FileLoc`).
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// A place in an input file: the file, and the 1-based line and column when known.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FileLoc {
+    /// The file, as the user named it (or as resolved from the scene's folder).
+    pub file: PathBuf,
+    /// 1-based line, when the problem has one.
+    pub line: Option<usize>,
+    /// 1-based column, when known.
+    pub column: Option<usize>,
+}
+
+impl FileLoc {
+    /// A whole file, with no line.
+    pub fn file(file: impl Into<PathBuf>) -> Self {
+        FileLoc { file: file.into(), line: None, column: None }
+    }
+
+    /// A line of a file.
+    pub fn line(file: impl Into<PathBuf>, line: usize) -> Self {
+        FileLoc { file: file.into(), line: Some(line), column: None }
+    }
+
+    /// The place of byte `offset` in `source`, the text of `file`.
+    pub fn at_offset(file: impl Into<PathBuf>, source: &str, offset: usize) -> Self {
+        let offset = offset.min(source.len());
+        let before = &source.as_bytes()[..offset];
+        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+        let column = offset - before.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1) + 1;
+        FileLoc { file: file.into(), line: Some(line), column: Some(column) }
+    }
+}
+
+impl fmt::Display for FileLoc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file.display())?;
+        if let Some(line) = self.line {
+            write!(f, ":{line}")?;
+            if let Some(column) = self.column {
+                write!(f, ":{column}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Everything that can go wrong in umbra.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Bad input at a known place: a scene or mesh that cannot be read as written.
+    #[error("{loc}: {message}")]
+    Input {
+        /// Where.
+        loc: FileLoc,
+        /// What is wrong, one line.
+        message: String,
+    },
+    /// A file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The system's reason.
+        source: std::io::Error,
+    },
+    /// An image could not be encoded or written.
+    #[error("{}: {source}", path.display())]
+    Image {
+        /// The file.
+        path: PathBuf,
+        /// The encoder's reason.
+        source: image::ImageError,
+    },
+    /// A request that the engine cannot carry out (an unknown method name, a scene built by
+    /// the API with values out of range, a method that does not apply to the scene).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl Error {
+    /// An input error at `loc`.
+    pub fn input(loc: FileLoc, message: impl Into<String>) -> Self {
+        Error::Input { loc, message: message.into() }
+    }
+}
+
+/// `Result` with umbra's [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;

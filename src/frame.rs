@@ -1,0 +1,105 @@
+//! The frame: colour, and the analysis buffers of `SCENE_FORMAT.md` section 4 (face id per
+//! pixel, lit fraction per light), with their PNG encodings.
+
+use crate::error::{Error, Result};
+use glam::Vec3;
+use std::path::Path;
+
+/// Face id of background pixels.
+pub const BACKGROUND: u32 = u32::MAX;
+
+/// A rendered image and its analysis buffers, row-major from the top-left pixel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Linear colour.
+    pub color: Vec<Vec3>,
+    /// Global face id seen at each pixel centre, [`BACKGROUND`] for none.
+    pub id: Vec<u32>,
+    /// `light[k][pixel]`: lit fraction of light `k` at the visible point (0 on background).
+    pub light: Vec<Vec<f32>>,
+}
+
+impl Frame {
+    /// A frame of background pixels.
+    pub fn new(width: u32, height: u32, lights: usize, background: Vec3) -> Frame {
+        let n = width as usize * height as usize;
+        Frame { width, height, color: vec![background; n], id: vec![BACKGROUND; n], light: vec![vec![0.0; n]; lights] }
+    }
+
+    fn save(&self, img: image::DynamicImage, path: &Path) -> Result<()> {
+        img.save_with_format(path, image::ImageFormat::Png)
+            .map_err(|e| Error::Image { path: path.to_owned(), source: e })
+    }
+
+    /// The colour image, clamped to [0, 1], optionally raised to `1/gamma` for display.
+    pub fn color_image(&self, gamma: Option<f32>) -> image::RgbImage {
+        let encode = |c: f32| {
+            let c = c.clamp(0.0, 1.0);
+            let c = gamma.map_or(c, |g| c.powf(1.0 / g));
+            (c * 255.0).round() as u8
+        };
+        image::RgbImage::from_fn(self.width, self.height, |x, y| {
+            let c = self.color[(y * self.width + x) as usize];
+            image::Rgb([encode(c.x), encode(c.y), encode(c.z)])
+        })
+    }
+
+    /// `id.png`: the face id as a little-endian u32 in R, G, B, A.
+    pub fn id_image(&self) -> image::RgbaImage {
+        image::RgbaImage::from_fn(self.width, self.height, |x, y| {
+            image::Rgba(self.id[(y * self.width + x) as usize].to_le_bytes())
+        })
+    }
+
+    /// `light<k>.png`: `round(255 * lit fraction)`.
+    pub fn light_image(&self, k: usize) -> image::GrayImage {
+        image::GrayImage::from_fn(self.width, self.height, |x, y| {
+            image::Luma([(255.0 * self.light[k][(y * self.width + x) as usize] as f64).round() as u8])
+        })
+    }
+
+    /// Writes the colour image as PNG.
+    pub fn save_png(&self, path: &Path, gamma: Option<f32>) -> Result<()> {
+        self.save(self.color_image(gamma).into(), path)
+    }
+
+    /// Writes `id.png` and `light<k>.png` into `dir` (created if missing).
+    pub fn save_aovs(&self, dir: &Path) -> Result<()> {
+        std::fs::create_dir_all(dir).map_err(|e| Error::Io { path: dir.to_owned(), source: e })?;
+        self.save(self.id_image().into(), &dir.join("id.png"))?;
+        for k in 0..self.light.len() {
+            self.save(self.light_image(k).into(), &dir.join(format!("light{k}.png")))?;
+        }
+        Ok(())
+    }
+
+    /// Whether pixel `(x, y)` is id-interior: not on the border, and its 3x3 neighbourhood
+    /// has one face id (the pixels visibility stages are compared at).
+    pub fn is_id_interior(&self, x: u32, y: u32) -> bool {
+        self.uniform_3x3(x, y, false)
+    }
+
+    /// Whether pixel `(x, y)` is interior: not on the border, and its 3x3 neighbourhood has
+    /// one face id and one lit value per light (the pixels shadow stages are compared at).
+    pub fn is_interior(&self, x: u32, y: u32) -> bool {
+        self.uniform_3x3(x, y, true)
+    }
+
+    fn uniform_3x3(&self, x: u32, y: u32, lights: bool) -> bool {
+        if x == 0 || y == 0 || x + 1 >= self.width || y + 1 >= self.height {
+            return false;
+        }
+        let at = |x: u32, y: u32| (y * self.width + x) as usize;
+        let c = at(x, y);
+        (y - 1..=y + 1).all(|yy| {
+            (x - 1..=x + 1).all(|xx| {
+                let k = at(xx, yy);
+                self.id[k] == self.id[c] && (!lights || self.light.iter().all(|l| l[k] == l[c]))
+            })
+        })
+    }
+}

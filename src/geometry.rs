@@ -1,0 +1,233 @@
+//! Planar polygons in f64: Newell normals, planes, the planarity and degeneracy rules of
+//! `SCENE_FORMAT.md` section 2, clipping by a plane, and point-in-polygon by the even-odd rule.
+
+use glam::{DVec2, DVec3};
+
+/// A plane `n . x + d = 0` with unit normal `n`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    /// Unit normal (the polygon's front side, by the right-hand rule).
+    pub n: DVec3,
+    /// Offset: `n . x + d = 0` on the plane.
+    pub d: f64,
+}
+
+impl Plane {
+    /// The plane through `point` with unit normal `n`.
+    pub fn new(n: DVec3, point: DVec3) -> Self {
+        Plane { n, d: -n.dot(point) }
+    }
+
+    /// Signed distance of `p` from the plane (positive on the front side).
+    #[inline]
+    pub fn distance(&self, p: DVec3) -> f64 {
+        self.n.dot(p) + self.d
+    }
+}
+
+/// Newell's normal of a polygon: twice its area times its unit normal (zero when degenerate).
+pub fn newell_normal(verts: &[DVec3]) -> DVec3 {
+    let mut n = DVec3::ZERO;
+    for (i, a) in verts.iter().enumerate() {
+        let b = verts[(i + 1) % verts.len()];
+        n.x += (a.y - b.y) * (a.z + b.z);
+        n.y += (a.z - b.z) * (a.x + b.x);
+        n.z += (a.x - b.x) * (a.y + b.y);
+    }
+    n
+}
+
+/// The average of a polygon's vertices.
+pub fn centroid(verts: &[DVec3]) -> DVec3 {
+    verts.iter().copied().sum::<DVec3>() / verts.len() as f64
+}
+
+/// The largest distance between two vertices.
+pub fn diameter(verts: &[DVec3]) -> f64 {
+    let mut d2: f64 = 0.0;
+    for (i, a) in verts.iter().enumerate() {
+        for b in &verts[i + 1..] {
+            d2 = d2.max(a.distance_squared(*b));
+        }
+    }
+    d2.sqrt()
+}
+
+/// What the rules of section 2 make of one face, as indices into the face's vertex list.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FaceShape {
+    /// Fewer than 3 distinct vertices, or zero area: keeps its id, draws nothing.
+    Degenerate,
+    /// A planar polygon (consecutive duplicate vertices removed) and its plane.
+    Planar(Vec<usize>, Plane),
+    /// A non-planar face: the fan of triangles from its first vertex, each with its plane
+    /// (degenerate triangles of the fan are left out).
+    Fan(Vec<([usize; 3], Plane)>),
+}
+
+/// Classifies a face by the planarity and degeneracy rules of `SCENE_FORMAT.md` section 2.
+pub fn classify_face(verts: &[DVec3]) -> FaceShape {
+    let mut idx: Vec<usize> = Vec::with_capacity(verts.len());
+    for (i, &p) in verts.iter().enumerate() {
+        if idx.last().map(|&j| verts[j]) != Some(p) {
+            idx.push(i);
+        }
+    }
+    while idx.len() > 1 && verts[idx[0]] == verts[*idx.last().unwrap_or(&0)] {
+        idx.pop();
+    }
+    let v: Vec<DVec3> = idx.iter().map(|&i| verts[i]).collect();
+    let mut distinct = v.clone();
+    distinct.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).unwrap_or(std::cmp::Ordering::Equal));
+    distinct.dedup();
+    if distinct.len() < 3 {
+        return FaceShape::Degenerate;
+    }
+    let diam = diameter(&v);
+    let n = newell_normal(&v);
+    if n.length() <= 1e-12 * diam * diam {
+        return FaceShape::Degenerate;
+    }
+    let plane = Plane::new(n.normalize(), centroid(&v));
+    if v.iter().all(|&p| plane.distance(p).abs() <= 1e-6 * diam) {
+        return FaceShape::Planar(idx, plane);
+    }
+    let fan = (1..idx.len() - 1)
+        .filter_map(|i| {
+            let tri = [idx[0], idx[i], idx[i + 1]];
+            let pts = tri.map(|j| verts[j]);
+            let d = diameter(&pts);
+            let n = newell_normal(&pts);
+            (n.length() > 1e-12 * d * d).then(|| (tri, Plane::new(n.normalize(), centroid(&pts))))
+        })
+        .collect();
+    FaceShape::Fan(fan)
+}
+
+/// Clips a polygon (convex or not) to the half-space `dist(p) >= 0` (Sutherland-Hodgman).
+/// A concave polygon may come back with coincident "bridge" edges along the plane; the
+/// even-odd rule cancels them. Fewer than three vertices means nothing is left.
+pub fn clip_polygon(poly: &[DVec3], dist: impl Fn(DVec3) -> f64, out: &mut Vec<DVec3>) {
+    out.clear();
+    let Some(&last) = poly.last() else { return };
+    let mut prev = last;
+    let mut dprev = dist(prev);
+    for &cur in poly {
+        let dcur = dist(cur);
+        if (dprev >= 0.0) != (dcur >= 0.0) {
+            let t = dprev / (dprev - dcur);
+            let mut p = prev + (cur - prev) * t;
+            // Snap the crossing exactly onto the plane along the edge's dominant change.
+            if dcur >= 0.0 && t >= 1.0 {
+                p = cur;
+            } else if dprev >= 0.0 && t <= 0.0 {
+                p = prev;
+            }
+            out.push(p);
+        }
+        if dcur >= 0.0 {
+            out.push(cur);
+        }
+        prev = cur;
+        dprev = dcur;
+    }
+    if out.len() < 3 {
+        out.clear();
+    }
+}
+
+/// Whether `p` lies inside the 2D polygon `ring` by the even-odd rule, with the scan
+/// converter's half-open convention: an edge is crossed for `y_top <= p.y < y_bottom`, and a
+/// point is inside a span `[x_left, x_right)` that the crossings bound.
+pub fn inside_even_odd(ring: &[DVec2], p: DVec2) -> bool {
+    let mut inside = false;
+    let Some(&last) = ring.last() else { return false };
+    let mut a = last;
+    for &b in ring {
+        let (top, bot) = if a.y <= b.y { (a, b) } else { (b, a) };
+        if top.y <= p.y && p.y < bot.y {
+            let x = top.x + (p.y - top.y) * ((bot.x - top.x) / (bot.y - top.y));
+            if x <= p.x {
+                inside = !inside;
+            }
+        }
+        a = b;
+    }
+    inside
+}
+
+/// The 2D projection of a 3D point that drops the normal's dominant axis, for point-in-polygon
+/// tests on a plane.
+#[inline]
+pub fn drop_axis(p: DVec3, axis: usize) -> DVec2 {
+    match axis {
+        0 => DVec2::new(p.y, p.z),
+        1 => DVec2::new(p.z, p.x),
+        _ => DVec2::new(p.x, p.y),
+    }
+}
+
+/// The index of the largest component of `|n|`.
+#[inline]
+pub fn dominant_axis(n: DVec3) -> usize {
+    let a = n.abs();
+    if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn newell_normal_of_unit_square_is_twice_its_area() {
+        let sq = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        assert_eq!(newell_normal(&sq), DVec3::new(0.0, 0.0, 2.0));
+    }
+
+    #[test]
+    fn classify_rules() {
+        let sq = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        assert!(matches!(classify_face(&sq), FaceShape::Planar(v, _) if v == vec![0, 1, 2, 3]));
+        assert_eq!(classify_face(&sq[..2]), FaceShape::Degenerate);
+        let line = [DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)];
+        assert_eq!(classify_face(&line), FaceShape::Degenerate);
+        let dup = [DVec3::ZERO, DVec3::X, DVec3::X, DVec3::ZERO];
+        assert_eq!(classify_face(&dup), FaceShape::Degenerate);
+        let bent = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.1), DVec3::Y];
+        match classify_face(&bent) {
+            FaceShape::Fan(tris) => {
+                let idx: Vec<[usize; 3]> = tris.iter().map(|t| t.0).collect();
+                assert_eq!(idx, vec![[0, 1, 2], [0, 2, 3]]);
+            }
+            other => panic!("expected a fan, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn clip_keeps_the_positive_side() {
+        let sq = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        let mut out = Vec::new();
+        clip_polygon(&sq, |p| p.x - 0.25, &mut out);
+        assert_eq!(out.len(), 4);
+        assert!(out.iter().all(|p| p.x >= 0.25));
+        let area = newell_normal(&out).length() / 2.0;
+        assert!((area - 0.75).abs() < 1e-12);
+        clip_polygon(&sq, |p| p.x - 2.0, &mut out);
+        assert!(out.is_empty());
+    }
+
+    #[test]
+    fn even_odd_inside() {
+        let ring = [DVec2::ZERO, DVec2::new(4.0, 0.0), DVec2::new(4.0, 4.0), DVec2::new(0.0, 4.0)];
+        assert!(inside_even_odd(&ring, DVec2::new(2.0, 2.0)));
+        assert!(!inside_even_odd(&ring, DVec2::new(5.0, 2.0)));
+        assert!(inside_even_odd(&ring, DVec2::new(0.0, 0.0)));
+        assert!(!inside_even_odd(&ring, DVec2::new(4.0, 2.0)));
+    }
+}

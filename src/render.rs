@@ -1,0 +1,210 @@
+//! The pipeline: scene -> view -> visibility runs -> shadow -> shading -> frame.
+//!
+//! The frame is cut into bands of lines rendered in parallel (rayon); within a band the
+//! visibility stage and the shadow walker step down the lines in order, as a scanline
+//! renderer does, and each run is shaded as soon as it is known.
+
+use crate::error::Result;
+use crate::frame::Frame;
+use crate::scene::Scene;
+use crate::shading::Shader;
+use crate::shadow::{ShadowContext, ShadowMethod};
+use crate::stats::{Counters, Stats};
+use crate::view::View;
+use crate::visibility::VisibilityMethod;
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use std::io::IsTerminal;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// What to render with.
+#[derive(Debug, Clone)]
+pub struct RenderOptions {
+    /// The hidden-surface stage.
+    pub visibility: VisibilityMethod,
+    /// The shadow stage.
+    pub shadows: ShadowMethod,
+    /// Show a progress bar on stderr when the render takes more than a second and stderr is
+    /// a terminal.
+    pub progress: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions { visibility: VisibilityMethod::Scanline, shadows: ShadowMethod::DEFAULT, progress: false }
+    }
+}
+
+/// A rendered frame and what it took.
+#[derive(Debug, Clone)]
+pub struct Rendered {
+    /// The image and its analysis buffers.
+    pub frame: Frame,
+    /// Counters and times.
+    pub stats: Stats,
+}
+
+/// Lines per band: enough bands to keep every core busy, few enough that each band's setup
+/// (the active edges at its first line) stays small.
+pub fn band_height(height: u32) -> u32 {
+    let bands = (rayon::current_num_threads() as u32 * 4).max(1);
+    height.div_ceil(bands).clamp(8, 64)
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// One band's output rows.
+struct Band {
+    y0: u32,
+    color: Vec<Vec3>,
+    id: Vec<u32>,
+    light: Vec<Vec<f32>>,
+    vis: Counters,
+    shadow: Counters,
+}
+
+/// Renders `scene` with the chosen stages.
+pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
+    let start = Instant::now();
+    let mut stats = Stats {
+        visibility: opts.visibility.name().into(),
+        shadows: opts.shadows.name().into(),
+        width: scene.camera.width,
+        height: scene.camera.height,
+        polygons: scene.polygons.len(),
+        ..Stats::default()
+    };
+    let view = View::new(&scene.camera);
+    let (w, h) = (view.width, view.height);
+
+    let t = Instant::now();
+    let screen = view.screen_polygons(scene);
+    stats.visibility_counters.add("screen_polygons", screen.len() as u64);
+    stats.time_ms.insert("view", ms(t.elapsed()));
+
+    let t = Instant::now();
+    let visibility = opts.visibility.prepare(scene, &view, &screen, &mut stats.visibility_counters);
+    stats.time_ms.insert("visibility_prepare", ms(t.elapsed()));
+
+    let t = Instant::now();
+    let ctx = ShadowContext::new(scene, &view);
+    stats.light_samples = ctx.samples.iter().map(Vec::len).sum();
+    let shadows = opts.shadows.prepare(&ctx, &mut stats.shadow_counters)?;
+    stats.time_ms.insert("shadow_prepare", ms(t.elapsed()));
+
+    let t = Instant::now();
+    let shader = Shader::new(scene, &view, &ctx.samples);
+    let band = band_height(h);
+    let nbands = h.div_ceil(band);
+    let progress = Mutex::new(Progress::new(opts.progress, h as u64));
+    let bands: Vec<Band> = (0..nbands)
+        .into_par_iter()
+        .map(|b| {
+            let y0 = b * band;
+            let y1 = (y0 + band).min(h);
+            let n = ((y1 - y0) * w) as usize;
+            let mut out = Band {
+                y0,
+                color: vec![scene.render.background; n],
+                id: vec![crate::frame::BACKGROUND; n],
+                light: vec![vec![0.0; n]; scene.lights.len()],
+                vis: Counters::default(),
+                shadow: Counters::default(),
+            };
+            let mut walker = shadows.walker();
+            let mut lit = vec![0.0f32; w as usize];
+            let mut self_shadowed = 0u64;
+            visibility.walk(y0..y1, &mut out.vis, &mut |y, runs| {
+                walker.start_line(y);
+                let row = ((y - y0) * w) as usize;
+                for run in runs {
+                    let (a, b) = (row + run.x0 as usize, row + run.x1 as usize);
+                    let poly = &scene.polygons[run.poly as usize];
+                    out.id[a..b].fill(poly.face);
+                    out.color[a..b].fill(shader.ambient(run.poly as usize));
+                    for (l, samples) in ctx.samples.iter().enumerate() {
+                        let share = 1.0 / samples.len() as f32;
+                        for (s, sample) in samples.iter().enumerate() {
+                            let lit = &mut lit[..(run.x1 - run.x0) as usize];
+                            if sample.on_seen_side(&poly.plane, view.eye) {
+                                walker.lit(l, s, y, run, lit);
+                            } else {
+                                lit.fill(0.0);
+                                self_shadowed += 1;
+                            }
+                            for (f, &v) in out.light[l][a..b].iter_mut().zip(lit.iter()) {
+                                *f += v * share;
+                            }
+                            shader.add_light(run.poly as usize, l, s, lit, &mut out.color[a..b]);
+                        }
+                    }
+                }
+            });
+            walker.finish(&mut out.shadow);
+            out.shadow.add("self_shadowed_runs", self_shadowed);
+            if let Ok(mut p) = progress.lock() {
+                p.advance((y1 - y0) as u64);
+            }
+            out
+        })
+        .collect();
+    if let Ok(p) = progress.lock() {
+        p.finish();
+    }
+
+    let mut frame = Frame::new(w, h, scene.lights.len(), scene.render.background);
+    for b in bands {
+        let at = (b.y0 * w) as usize;
+        let n = b.id.len();
+        frame.color[at..at + n].copy_from_slice(&b.color);
+        frame.id[at..at + n].copy_from_slice(&b.id);
+        for (dst, src) in frame.light.iter_mut().zip(&b.light) {
+            dst[at..at + n].copy_from_slice(src);
+        }
+        stats.visibility_counters.merge(&b.vis);
+        stats.shadow_counters.merge(&b.shadow);
+    }
+    stats.time_ms.insert("scan", ms(t.elapsed()));
+    stats.time_ms.insert("total", ms(start.elapsed()));
+    Ok(Rendered { frame, stats })
+}
+
+/// A progress bar that appears only after a second, and only on a terminal.
+struct Progress {
+    bar: Option<ProgressBar>,
+    enabled: bool,
+    start: Instant,
+    done: u64,
+    total: u64,
+}
+
+impl Progress {
+    fn new(enabled: bool, total: u64) -> Self {
+        Progress { bar: None, enabled: enabled && std::io::stderr().is_terminal(), start: Instant::now(), done: 0, total }
+    }
+
+    fn advance(&mut self, n: u64) {
+        self.done += n;
+        if self.bar.is_none() && self.enabled && self.start.elapsed() > Duration::from_secs(1) {
+            let bar = ProgressBar::with_draw_target(Some(self.total), ProgressDrawTarget::stderr());
+            if let Ok(style) = ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} lines {elapsed}") {
+                bar.set_style(style);
+            }
+            bar.set_message("rendering");
+            self.bar = Some(bar);
+        }
+        if let Some(bar) = &self.bar {
+            bar.set_position(self.done);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}

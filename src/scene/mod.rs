@@ -1,0 +1,544 @@
+//! Scenes: the camera, materials, lights and objects of `SCENE_FORMAT.md`, and the world-space
+//! polygons they compile to. Every polygon keeps its global face id.
+
+mod load;
+mod obj;
+mod write;
+
+pub use obj::parse_obj;
+
+use crate::error::{Error, Result};
+use crate::geometry::{classify_face, newell_normal, FaceShape, Plane};
+use glam::{DMat3, DMat4, DVec3, Vec3};
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+/// The pinhole camera of section 3.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub eye: DVec3,
+    /// Point looked at.
+    pub target: DVec3,
+    /// Up hint (default +Y).
+    pub up: DVec3,
+    /// Vertical field of view in degrees (default 45).
+    pub fov_y: f64,
+    /// Image width in pixels (default 640).
+    pub width: u32,
+    /// Image height in pixels (default 480).
+    pub height: u32,
+    /// Camera-space depth of the near plane (default 0.01).
+    pub near: f64,
+    /// Camera-space depth of the far plane, if any.
+    pub far: Option<f64>,
+}
+
+impl Camera {
+    /// A camera at `eye` looking at `target` with the contract's defaults.
+    pub fn new(eye: DVec3, target: DVec3) -> Self {
+        Camera { eye, target, up: DVec3::Y, fov_y: 45.0, width: 640, height: 480, near: 0.01, far: None }
+    }
+
+    fn validate(&self) -> std::result::Result<(), String> {
+        let f = self.target - self.eye;
+        if f.length() == 0.0 {
+            return Err("camera eye and target are the same point".into());
+        }
+        if f.normalize().cross(self.up).length() < 1e-9 {
+            return Err("camera up is parallel to the view direction".into());
+        }
+        if !(self.fov_y > 0.0 && self.fov_y < 180.0) {
+            return Err(format!("camera fov_y must be in (0, 180) degrees, got {}", self.fov_y));
+        }
+        if self.width == 0 || self.height == 0 || self.width > 32768 || self.height > 32768 {
+            return Err(format!("camera size {}x{} must be 1..=32768 each way", self.width, self.height));
+        }
+        if self.near <= 0.0 {
+            return Err(format!("camera near must be > 0, got {}", self.near));
+        }
+        if let Some(far) = self.far {
+            if far <= self.near {
+                return Err(format!("camera far ({far}) must be beyond near ({})", self.near));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The `[render]` table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSettings {
+    /// Global ambient intensity I_a.
+    pub ambient: Vec3,
+    /// Background colour.
+    pub background: Vec3,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings { ambient: Vec3::splat(0.1), background: Vec3::ZERO }
+    }
+}
+
+/// Specular reflection model of a material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpecularModel {
+    /// Phong: `(R.V)^n`.
+    #[default]
+    Phong,
+    /// Blinn: `(N.H)^n`.
+    Blinn,
+    /// Cook-Torrance microfacet model.
+    CookTorrance,
+}
+
+/// How a polygon's interior is coloured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadingMode {
+    /// One colour per polygon, lit at its centroid.
+    #[default]
+    Flat,
+    /// Vertex colours interpolated.
+    Gouraud,
+    /// Vertex normals interpolated, lit per pixel.
+    Phong,
+}
+
+/// A `[[material]]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    /// Name objects refer to it by.
+    pub name: String,
+    /// Diffuse (object) colour O_d.
+    pub color: Vec3,
+    /// Specular colour O_s.
+    pub specular_color: Vec3,
+    /// Ambient coefficient.
+    pub ka: f32,
+    /// Diffuse coefficient.
+    pub kd: f32,
+    /// Specular coefficient.
+    pub ks: f32,
+    /// Specular exponent n.
+    pub shininess: f32,
+    /// Specular model.
+    pub model: SpecularModel,
+    /// Cook-Torrance roughness (Beckmann m).
+    pub roughness: f32,
+    /// Shading mode.
+    pub shading: ShadingMode,
+}
+
+impl Material {
+    /// A material with the contract's defaults.
+    pub fn new(name: impl Into<String>) -> Self {
+        Material {
+            name: name.into(),
+            color: Vec3::splat(0.8),
+            specular_color: Vec3::ONE,
+            ka: 1.0,
+            kd: 0.8,
+            ks: 0.0,
+            shininess: 32.0,
+            model: SpecularModel::Phong,
+            roughness: 0.3,
+            shading: ShadingMode::Flat,
+        }
+    }
+}
+
+/// What kind of light, with its geometry.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LightKind {
+    /// A point light.
+    Point {
+        /// Where.
+        position: DVec3,
+    },
+    /// A light at infinity.
+    Directional {
+        /// The unit direction the light travels.
+        direction: DVec3,
+    },
+    /// A point light with a cone.
+    Spot {
+        /// Where.
+        position: DVec3,
+        /// Unit axis of the cone (the way the light travels).
+        direction: DVec3,
+        /// Half-angle of the cone in degrees.
+        cutoff: f64,
+        /// Falloff `cos^exponent` inside the cone.
+        exponent: f64,
+    },
+    /// A parallelogram sampled by a fixed grid of point lights.
+    Area {
+        /// One corner.
+        corner: DVec3,
+        /// First edge.
+        edge_u: DVec3,
+        /// Second edge.
+        edge_v: DVec3,
+        /// Grid size `[m, n]`.
+        samples: [u32; 2],
+    },
+}
+
+/// A `[[light]]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Light {
+    /// Geometry.
+    pub kind: LightKind,
+    /// Colour.
+    pub color: Vec3,
+    /// Intensity (shared among an area light's samples).
+    pub intensity: f32,
+    /// Attenuation `[a, b, c]`: `f_att = min(1, 1/(a + b d + c d^2))`.
+    pub attenuation: [f64; 3],
+}
+
+/// One point of a light that shadows are computed for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightSample {
+    /// A point light, or one sample of a spot or area light.
+    Point(DVec3),
+    /// A directional light: the unit direction the light travels.
+    Directional(DVec3),
+}
+
+impl LightSample {
+    /// Whether the light is on the side of `plane` that the eye is on (the same-side rule of
+    /// section 3). Both distances must be non-zero; a light on the plane lights neither side.
+    pub fn on_seen_side(&self, plane: &Plane, eye: DVec3) -> bool {
+        let e = plane.distance(eye);
+        let l = match *self {
+            LightSample::Point(s) => plane.distance(s),
+            LightSample::Directional(d) => -plane.n.dot(d),
+        };
+        e != 0.0 && l != 0.0 && (e > 0.0) == (l > 0.0)
+    }
+
+    /// Unit vector from `p` toward the light, and the distance (infinite for directional).
+    pub fn toward(&self, p: DVec3) -> (DVec3, f64) {
+        match *self {
+            LightSample::Point(s) => {
+                let v = s - p;
+                let d = v.length();
+                (v / d, d)
+            }
+            LightSample::Directional(d) => (-d, f64::INFINITY),
+        }
+    }
+}
+
+impl Light {
+    /// The light's samples: one for point, spot and directional lights, `m*n` for area lights
+    /// at `corner + (i+0.5)/m edge_u + (j+0.5)/n edge_v`.
+    pub fn samples(&self) -> Vec<LightSample> {
+        match self.kind {
+            LightKind::Point { position } | LightKind::Spot { position, .. } => vec![LightSample::Point(position)],
+            LightKind::Directional { direction } => vec![LightSample::Directional(direction)],
+            LightKind::Area { corner, edge_u, edge_v, samples: [m, n] } => (0..m)
+                .flat_map(|i| {
+                    (0..n).map(move |j| {
+                        let u = (i as f64 + 0.5) / m as f64;
+                        let v = (j as f64 + 0.5) / n as f64;
+                        LightSample::Point(corner + u * edge_u + v * edge_v)
+                    })
+                })
+                .collect(),
+        }
+    }
+
+    /// Number of samples.
+    pub fn sample_count(&self) -> usize {
+        match self.kind {
+            LightKind::Area { samples: [m, n], .. } => (m * n) as usize,
+            _ => 1,
+        }
+    }
+
+    fn validate(&self) -> std::result::Result<(), String> {
+        let a = self.attenuation;
+        if a.iter().any(|&c| !(c >= 0.0)) || a.iter().all(|&c| c == 0.0) {
+            return Err(format!("attenuation {a:?} must be >= 0 and not all zero"));
+        }
+        match &self.kind {
+            LightKind::Directional { direction } | LightKind::Spot { direction, .. }
+                if (direction.length() - 1.0).abs() > 1e-9 =>
+            {
+                Err("light direction must be a unit vector".into())
+            }
+            LightKind::Spot { cutoff, .. } if !(*cutoff > 0.0 && *cutoff <= 180.0) => {
+                Err(format!("spot cutoff must be in (0, 180] degrees, got {cutoff}"))
+            }
+            LightKind::Area { edge_u, edge_v, samples, .. } => {
+                if samples[0] == 0 || samples[1] == 0 || samples[0] as u64 * samples[1] as u64 > 4096 {
+                    Err(format!("area light samples {samples:?} must each be >= 1, at most 4096 in all"))
+                } else if edge_u.cross(*edge_v).length() == 0.0 {
+                    Err("area light edges edge_u and edge_v are parallel or zero".into())
+                } else {
+                    Ok(())
+                }
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// A polygon mesh as read: positions, normals and faces that index them.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Vertex normals (`vn`).
+    pub normals: Vec<DVec3>,
+    /// Faces, in file order (each one a face id).
+    pub faces: Vec<Face>,
+}
+
+/// One face of a [`Mesh`]: 0-based indices.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Face {
+    /// Position indices.
+    pub vertices: Vec<u32>,
+    /// Normal indices, one per vertex, or empty.
+    pub normals: Vec<u32>,
+}
+
+impl Mesh {
+    /// A mesh of separate polygons (the `polygons = [...]` form).
+    pub fn from_polygons(polys: &[Vec<DVec3>]) -> Mesh {
+        let mut mesh = Mesh::default();
+        for p in polys {
+            let first = mesh.positions.len() as u32;
+            mesh.positions.extend_from_slice(p);
+            mesh.faces.push(Face { vertices: (first..first + p.len() as u32).collect(), normals: Vec::new() });
+        }
+        mesh
+    }
+}
+
+/// Object transform `M = T(translate) Rz Ry Rx S(scale)`, angles in degrees.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Transform {
+    /// Scale per axis.
+    pub scale: DVec3,
+    /// Rotation about X, then Y, then Z, degrees.
+    pub rotate: DVec3,
+    /// Translation.
+    pub translate: DVec3,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Transform { scale: DVec3::ONE, rotate: DVec3::ZERO, translate: DVec3::ZERO }
+    }
+}
+
+impl Transform {
+    /// The matrix `T Rz Ry Rx S`.
+    pub fn matrix(&self) -> DMat4 {
+        let r = self.rotate * (std::f64::consts::PI / 180.0);
+        DMat4::from_translation(self.translate)
+            * DMat4::from_rotation_z(r.z)
+            * DMat4::from_rotation_y(r.y)
+            * DMat4::from_rotation_x(r.x)
+            * DMat4::from_scale(self.scale)
+    }
+}
+
+/// An `[[object]]`: a mesh placed in the world with a material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Object {
+    /// Optional name.
+    pub name: Option<String>,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+    /// The mesh in object space.
+    pub mesh: Arc<Mesh>,
+    /// Placement.
+    pub transform: Transform,
+    /// Whether its polygons cast shadows.
+    pub casts_shadows: bool,
+    /// Whether Blinn's planar shadows are projected onto its polygons.
+    pub receiver: bool,
+}
+
+/// A world-space planar polygon. Its vertices are `scene.vertices[start..start+len]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Polygon {
+    /// Global face id (pieces of a non-planar face share it).
+    pub face: u32,
+    /// Index into [`Scene::objects`].
+    pub object: u32,
+    /// First vertex in [`Scene::vertices`].
+    pub start: u32,
+    /// Vertex count (at least 3).
+    pub len: u32,
+    /// Its plane; the normal is the Newell normal (front side counter-clockwise).
+    pub plane: Plane,
+}
+
+/// A scene, as described and as compiled to world-space polygons.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Global settings.
+    pub render: RenderSettings,
+    /// Materials (at least one).
+    pub materials: Vec<Material>,
+    /// Lights in file order.
+    pub lights: Vec<Light>,
+    /// Objects in file order.
+    pub objects: Vec<Object>,
+    /// World-space polygons, degenerate faces left out, non-planar faces split into fans.
+    pub polygons: Vec<Polygon>,
+    /// Vertex positions of all polygons.
+    pub vertices: Vec<DVec3>,
+    /// Unit vertex normals, parallel to `vertices` (from `vn`, or averaged over the faces
+    /// sharing the vertex).
+    pub normals: Vec<DVec3>,
+    /// Number of face ids in the scene (degenerate faces included).
+    pub face_count: u32,
+}
+
+impl Scene {
+    /// Builds a scene from its parts, checking values and compiling the world polygons.
+    /// An empty `materials` gets the grey default.
+    pub fn new(
+        camera: Camera,
+        render: RenderSettings,
+        mut materials: Vec<Material>,
+        lights: Vec<Light>,
+        objects: Vec<Object>,
+    ) -> Result<Scene> {
+        camera.validate().map_err(Error::Invalid)?;
+        for (i, l) in lights.iter().enumerate() {
+            l.validate().map_err(|m| Error::Invalid(format!("light {i}: {m}")))?;
+        }
+        if materials.is_empty() {
+            materials.push(Material::new("default"));
+        }
+        for (i, o) in objects.iter().enumerate() {
+            if o.material >= materials.len() {
+                return Err(Error::Invalid(format!("object {i}: material index {} out of range", o.material)));
+            }
+            let m = &o.mesh;
+            let bad = m.faces.iter().any(|f| {
+                f.vertices.iter().any(|&v| v as usize >= m.positions.len())
+                    || f.normals.iter().any(|&v| v as usize >= m.normals.len())
+                    || (!f.normals.is_empty() && f.normals.len() != f.vertices.len())
+            });
+            if bad {
+                return Err(Error::Invalid(format!("object {i}: face index out of range")));
+            }
+            let finite = m.positions.iter().chain(&m.normals).all(|p| p.is_finite());
+            let t = &o.transform;
+            if !finite || !(t.scale.is_finite() && t.rotate.is_finite() && t.translate.is_finite()) {
+                return Err(Error::Invalid(format!("object {i}: non-finite coordinate")));
+            }
+        }
+        let mut scene = Scene {
+            camera,
+            render,
+            materials,
+            lights,
+            objects,
+            polygons: Vec::new(),
+            vertices: Vec::new(),
+            normals: Vec::new(),
+            face_count: 0,
+        };
+        scene.compile();
+        Ok(scene)
+    }
+
+    fn compile(&mut self) {
+        for (oi, obj) in self.objects.iter().enumerate() {
+            let m = obj.transform.matrix();
+            let nm = DMat3::from_mat4(m).inverse().transpose();
+            let mesh = &obj.mesh;
+            let world: Vec<DVec3> = mesh.positions.iter().map(|&p| m.transform_point3(p)).collect();
+            let vn: Vec<DVec3> = mesh.normals.iter().map(|&n| (nm * n).normalize_or_zero()).collect();
+            // Averaged normals for faces without `vn`: area-weighted face normals per vertex.
+            let mut avg = vec![DVec3::ZERO; world.len()];
+            for f in mesh.faces.iter().filter(|f| f.normals.is_empty()) {
+                let pts: Vec<DVec3> = f.vertices.iter().map(|&v| world[v as usize]).collect();
+                let n = newell_normal(&pts);
+                for &v in &f.vertices {
+                    avg[v as usize] += n;
+                }
+            }
+            let mut pts = Vec::new();
+            for (fi, f) in mesh.faces.iter().enumerate() {
+                let face = self.face_count + fi as u32;
+                pts.clear();
+                pts.extend(f.vertices.iter().map(|&v| world[v as usize]));
+                let normal = |k: usize, plane: &Plane| {
+                    let n = if f.normals.is_empty() { avg[f.vertices[k] as usize] } else { vn[f.normals[k] as usize] };
+                    let n = n.normalize_or_zero();
+                    if n == DVec3::ZERO {
+                        plane.n
+                    } else {
+                        n
+                    }
+                };
+                let mut push = |idx: &[usize], plane: Plane| {
+                    let start = self.vertices.len() as u32;
+                    for &k in idx {
+                        self.vertices.push(pts[k]);
+                        self.normals.push(normal(k, &plane));
+                    }
+                    self.polygons.push(Polygon { face, object: oi as u32, start, len: idx.len() as u32, plane });
+                };
+                match classify_face(&pts) {
+                    FaceShape::Degenerate => {}
+                    FaceShape::Planar(idx, plane) => push(&idx, plane),
+                    FaceShape::Fan(tris) => {
+                        for (tri, plane) in tris {
+                            push(&tri, plane);
+                        }
+                    }
+                }
+            }
+            self.face_count += mesh.faces.len() as u32;
+        }
+    }
+
+    /// The vertices of polygon `i`.
+    #[inline]
+    pub fn verts(&self, i: usize) -> &[DVec3] {
+        let p = &self.polygons[i];
+        &self.vertices[p.start as usize..(p.start + p.len) as usize]
+    }
+
+    /// The vertex normals of polygon `i`.
+    #[inline]
+    pub fn vertex_normals(&self, i: usize) -> &[DVec3] {
+        let p = &self.polygons[i];
+        &self.normals[p.start as usize..(p.start + p.len) as usize]
+    }
+
+    /// Whether polygon `i` casts shadows.
+    #[inline]
+    pub fn casts_shadows(&self, i: usize) -> bool {
+        self.objects[self.polygons[i].object as usize].casts_shadows
+    }
+
+    /// The material of polygon `i`.
+    #[inline]
+    pub fn material(&self, i: usize) -> &Material {
+        &self.materials[self.objects[self.polygons[i].object as usize].material]
+    }
+
+    /// The axis-aligned bounds of all polygons (`None` when there are none).
+    pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
+        let first = *self.vertices.first()?;
+        Some(self.vertices.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+    }
+}

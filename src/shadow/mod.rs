@@ -1,0 +1,127 @@
+//! Shadow stages. Each is prepared once per render from the scene and the light samples
+//! (projections, detail polygons, volumes, depth maps, a BVH), then asked, run by run in
+//! scanline order, which pixels of a visible run each light sample reaches.
+//!
+//! The same-side rule of section 3 (a polygon whose seen side faces away from a light sample
+//! is in shadow from it — Bouknight and Kelley's self-shadowing test) is applied once by the
+//! pipeline, before any stage is asked; stages only answer for runs the rule leaves lit.
+
+mod ray_cast;
+
+pub use ray_cast::RayCastShadows;
+
+use crate::error::{Error, Result};
+use crate::scene::{LightSample, Scene};
+use crate::stats::Counters;
+use crate::view::View;
+use crate::visibility::Run;
+
+/// What every shadow stage is prepared from.
+pub struct ShadowContext<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The view.
+    pub view: &'a View,
+    /// Each light's samples (`samples[light][sample]`).
+    pub samples: Vec<Vec<LightSample>>,
+    /// The scene's size (diagonal of its bounds), for tolerances.
+    pub extent: f64,
+}
+
+impl<'a> ShadowContext<'a> {
+    /// The context for rendering `scene` from `view`.
+    pub fn new(scene: &'a Scene, view: &'a View) -> Self {
+        let samples = scene.lights.iter().map(|l| l.samples()).collect();
+        let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
+        ShadowContext { scene, view, samples, extent }
+    }
+}
+
+/// A prepared shadow stage.
+pub trait ShadowStage: Sync {
+    /// A walker for one band of lines; it is called in increasing line order.
+    fn walker(&self) -> Box<dyn ShadowWalker + '_>;
+}
+
+/// Answers, line by line, which pixels of each visible run a light sample reaches.
+pub trait ShadowWalker {
+    /// Called once for each line, in increasing order, before its runs.
+    fn start_line(&mut self, _line: u32) {}
+
+    /// Writes into `lit[i]` how much of sample `sample` of light `light` reaches pixel
+    /// `run.x0 + i` of `line`: 0 or 1 for exact stages, a fraction for filtered ones. Only
+    /// called for runs whose polygon faces the sample on its seen side.
+    fn lit(&mut self, light: usize, sample: usize, line: u32, run: &Run, lit: &mut [f32]);
+
+    /// Adds the walker's counters.
+    fn finish(&mut self, _counters: &mut Counters) {}
+}
+
+/// The shadow methods, chosen by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ShadowMethod {
+    /// No shadows: every sample reaches every point on its seen side.
+    None,
+    /// One shadow ray per pixel and light sample (the exact reference).
+    RayCast,
+}
+
+impl ShadowMethod {
+    /// The engine's recommended exact method (the default of `--shadows`).
+    pub const DEFAULT: ShadowMethod = ShadowMethod::RayCast;
+
+    /// Every method.
+    pub const ALL: [ShadowMethod; 2] = [ShadowMethod::None, ShadowMethod::RayCast];
+
+    /// The method's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowMethod::None => "none",
+            ShadowMethod::RayCast => "ray-cast",
+        }
+    }
+
+    /// Whether the method gives the exact answer of section 3.
+    pub fn is_exact(self) -> bool {
+        !matches!(self, ShadowMethod::None)
+    }
+
+    /// Prepares the stage.
+    pub fn prepare<'a>(self, ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Result<Box<dyn ShadowStage + 'a>> {
+        Ok(match self {
+            ShadowMethod::None => Box::new(NoShadows),
+            ShadowMethod::RayCast => Box::new(RayCastShadows::new(ctx, counters)),
+        })
+    }
+}
+
+impl std::str::FromStr for ShadowMethod {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
+            Error::Invalid(format!("unknown shadow method '{s}' (known: {})", known.join(", ")))
+        })
+    }
+}
+
+impl std::fmt::Display for ShadowMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The `none` stage.
+struct NoShadows;
+
+impl ShadowStage for NoShadows {
+    fn walker(&self) -> Box<dyn ShadowWalker + '_> {
+        Box::new(NoShadows)
+    }
+}
+
+impl ShadowWalker for NoShadows {
+    fn lit(&mut self, _: usize, _: usize, _: u32, _: &Run, lit: &mut [f32]) {
+        lit.fill(1.0);
+    }
+}

@@ -1,0 +1,61 @@
+//! The exact reference: for each pixel and light sample, one shadow ray from the visible
+//! point toward the sample, tested against a BVH of the shadow-casting polygons (section 3 of
+//! the contract, directly). Simple and obviously right; the oracle for the exact stages.
+
+use super::{ShadowContext, ShadowStage, ShadowWalker};
+use crate::bvh::Bvh;
+use crate::scene::LightSample;
+use crate::stats::Counters;
+use crate::visibility::Run;
+
+/// The prepared reference stage.
+pub struct RayCastShadows<'a> {
+    ctx: &'a ShadowContext<'a>,
+    bvh: Bvh,
+}
+
+impl<'a> RayCastShadows<'a> {
+    /// Builds the BVH of the shadow casters.
+    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
+        let s = ctx.scene;
+        let casters: Vec<u32> = (0..s.polygons.len() as u32).filter(|&i| s.casts_shadows(i as usize)).collect();
+        counters.add("casters", casters.len() as u64);
+        RayCastShadows { ctx, bvh: Bvh::new(s, casters) }
+    }
+}
+
+struct Walker<'s> {
+    stage: &'s RayCastShadows<'s>,
+    rays: u64,
+}
+
+impl ShadowStage for RayCastShadows<'_> {
+    fn walker(&self) -> Box<dyn ShadowWalker + '_> {
+        Box::new(Walker { stage: self, rays: 0 })
+    }
+}
+
+impl ShadowWalker for Walker<'_> {
+    fn lit(&mut self, light: usize, sample: usize, line: u32, run: &Run, lit: &mut [f32]) {
+        let ctx = self.stage.ctx;
+        let poly = &ctx.scene.polygons[run.poly as usize];
+        let yc = line as f64 + 0.5;
+        // Open segment: ends within a relative 1e-9 of P or of the light do not count.
+        let eps = 1e-9;
+        for (i, out) in lit.iter_mut().enumerate() {
+            let p = ctx.view.point_on(&poly.plane, (run.x0 + i as u32) as f64 + 0.5, yc);
+            let blocked = match ctx.samples[light][sample] {
+                LightSample::Point(s) => self.stage.bvh.occluded(ctx.scene, p, s - p, eps, 1.0 - eps, poly.face),
+                LightSample::Directional(d) => {
+                    self.stage.bvh.occluded(ctx.scene, p, -d, eps * ctx.extent, f64::INFINITY, poly.face)
+                }
+            };
+            *out = if blocked { 0.0 } else { 1.0 };
+        }
+        self.rays += lit.len() as u64;
+    }
+
+    fn finish(&mut self, counters: &mut Counters) {
+        counters.add("shadow_rays", self.rays);
+    }
+}

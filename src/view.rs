@@ -1,0 +1,228 @@
+//! The view: the camera basis and pixel-centre rule of `SCENE_FORMAT.md` section 3, clipping
+//! of world polygons to the near (and far) plane, and perspective projection to screen space.
+//!
+//! Screen space is continuous pixel coordinates: x to the right, y down, pixel `(px, py)`
+//! sampled at `(px + 0.5, py + 0.5)`. A planar polygon's inverse camera depth `1/z` is an
+//! affine function of screen position; each screen polygon carries it, derived straight from
+//! the world plane, so depth at a pixel centre is the exact ray-plane hit of section 3.
+
+use crate::geometry::{clip_polygon, Plane};
+use crate::scene::{Camera, Scene};
+use glam::{DVec2, DVec3};
+
+/// Camera basis and projection.
+#[derive(Debug, Clone, Copy)]
+pub struct View {
+    /// Eye position.
+    pub eye: DVec3,
+    /// Forward `f = normalize(target - eye)`.
+    pub f: DVec3,
+    /// Right `r = normalize(f x up)`.
+    pub r: DVec3,
+    /// Up `u = r x f`.
+    pub u: DVec3,
+    /// `tan(fov_y / 2)`.
+    pub t: f64,
+    /// Aspect `width / height`.
+    pub aspect: f64,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Near plane depth.
+    pub near: f64,
+    /// Far plane depth, if any.
+    pub far: Option<f64>,
+}
+
+/// `1/z = a x + b y + c` over screen position `(x, y)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DepthPlane {
+    /// d(1/z)/dx.
+    pub a: f64,
+    /// d(1/z)/dy.
+    pub b: f64,
+    /// 1/z at the screen origin.
+    pub c: f64,
+}
+
+impl DepthPlane {
+    /// Inverse depth at screen position `(x, y)`; larger is nearer.
+    #[inline]
+    pub fn inv_z(&self, x: f64, y: f64) -> f64 {
+        self.a * x + self.b * y + self.c
+    }
+}
+
+/// A polygon in screen space, ready to scan-convert.
+#[derive(Debug, Clone)]
+pub struct ScreenPolygon {
+    /// Index of the scene polygon it came from.
+    pub poly: u32,
+    /// Its vertices in screen space (one ring; near/far clipping keeps a single ring).
+    pub ring: Vec<DVec2>,
+    /// Its inverse depth over the screen.
+    pub depth: DepthPlane,
+}
+
+impl View {
+    /// The view of `camera`.
+    pub fn new(camera: &Camera) -> View {
+        let f = (camera.target - camera.eye).normalize();
+        let r = f.cross(camera.up).normalize();
+        let u = r.cross(f);
+        View {
+            eye: camera.eye,
+            f,
+            r,
+            u,
+            t: (camera.fov_y.to_radians() / 2.0).tan(),
+            aspect: camera.width as f64 / camera.height as f64,
+            width: camera.width,
+            height: camera.height,
+            near: camera.near,
+            far: camera.far,
+        }
+    }
+
+    /// Camera coordinates `(x, y, z)` of a world point: along r, u and f.
+    #[inline]
+    pub fn to_camera(&self, p: DVec3) -> DVec3 {
+        let v = p - self.eye;
+        DVec3::new(v.dot(self.r), v.dot(self.u), v.dot(self.f))
+    }
+
+    /// Screen position of a camera-space point with `z > 0`.
+    #[inline]
+    pub fn project(&self, c: DVec3) -> DVec2 {
+        let sx = c.x / c.z;
+        let sy = c.y / c.z;
+        DVec2::new(
+            (sx / (self.t * self.aspect) + 1.0) * 0.5 * self.width as f64,
+            (1.0 - sy / self.t) * 0.5 * self.height as f64,
+        )
+    }
+
+    /// The ray direction through screen position `(x, y)`, scaled so its component along `f`
+    /// is 1: the hit at parameter `s` has camera depth `s`.
+    #[inline]
+    pub fn ray(&self, x: f64, y: f64) -> DVec3 {
+        let sx = (2.0 * x / self.width as f64 - 1.0) * self.t * self.aspect;
+        let sy = (1.0 - 2.0 * y / self.height as f64) * self.t;
+        self.f + sx * self.r + sy * self.u
+    }
+
+    /// The world point on `plane` seen at screen position `(x, y)`.
+    #[inline]
+    pub fn point_on(&self, plane: &Plane, x: f64, y: f64) -> DVec3 {
+        let d = self.ray(x, y);
+        let s = -plane.distance(self.eye) / plane.n.dot(d);
+        self.eye + s * d
+    }
+
+    /// The inverse-depth plane of a world plane; `None` when the eye lies in it (edge-on).
+    pub fn depth_plane(&self, plane: &Plane) -> Option<DepthPlane> {
+        let e = plane.distance(self.eye);
+        if e == 0.0 {
+            return None;
+        }
+        // 1/z = -(n.f + sx n.r + sy n.u) / e, with sx, sy affine in x, y.
+        let k = -1.0 / e;
+        let (nr, nu) = (plane.n.dot(self.r) * self.t * self.aspect, plane.n.dot(self.u) * self.t);
+        Some(DepthPlane {
+            a: k * nr * 2.0 / self.width as f64,
+            b: -k * nu * 2.0 / self.height as f64,
+            c: k * (plane.n.dot(self.f) - nr + nu),
+        })
+    }
+
+    /// Clips a world polygon to `near <= z (<= far)` in camera space and projects it.
+    /// Returns `false` (and leaves `out` empty) when nothing is left.
+    pub fn clip_project(&self, verts: &[DVec3], scratch: &mut [Vec<DVec3>; 2], out: &mut Vec<DVec2>) -> bool {
+        out.clear();
+        let [a, b] = scratch;
+        a.clear();
+        a.extend(verts.iter().map(|&p| self.to_camera(p)));
+        if a.iter().any(|c| c.z < self.near) {
+            clip_polygon(a, |c| c.z - self.near, b);
+            std::mem::swap(a, b);
+        }
+        if let Some(far) = self.far {
+            if a.iter().any(|c| c.z > far) {
+                clip_polygon(a, |c| far - c.z, b);
+                std::mem::swap(a, b);
+            }
+        }
+        if a.len() < 3 {
+            return false;
+        }
+        out.extend(a.iter().map(|&c| self.project(c)));
+        true
+    }
+
+    /// Every polygon of the scene that survives clipping, in screen space.
+    pub fn screen_polygons(&self, scene: &Scene) -> Vec<ScreenPolygon> {
+        let mut scratch = [Vec::new(), Vec::new()];
+        let mut ring = Vec::new();
+        let mut out = Vec::with_capacity(scene.polygons.len());
+        for (i, p) in scene.polygons.iter().enumerate() {
+            let Some(depth) = self.depth_plane(&p.plane) else { continue };
+            if self.clip_project(scene.verts(i), &mut scratch, &mut ring) {
+                out.push(ScreenPolygon { poly: i as u32, ring: ring.clone(), depth });
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view() -> View {
+        let mut cam = Camera::new(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO);
+        cam.width = 64;
+        cam.height = 48;
+        View::new(&cam)
+    }
+
+    #[test]
+    fn projection_and_ray_agree() {
+        let v = view();
+        let p = DVec3::new(0.3, -0.2, 0.7);
+        let s = v.project(v.to_camera(p));
+        let d = v.ray(s.x, s.y);
+        let c = v.to_camera(p);
+        assert!((v.eye + c.z * d - p).length() < 1e-12);
+    }
+
+    #[test]
+    fn depth_plane_matches_ray_hit() {
+        let v = view();
+        let n = DVec3::new(0.2, 0.5, 1.0).normalize();
+        let plane = Plane::new(n, DVec3::new(0.1, 0.0, -0.5));
+        let dp = v.depth_plane(&plane).unwrap();
+        for &(x, y) in &[(3.5, 7.5), (40.5, 30.5), (63.5, 0.5)] {
+            let p = v.point_on(&plane, x, y);
+            let z = v.to_camera(p).z;
+            assert!((dp.inv_z(x, y) - 1.0 / z).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn near_clipping_keeps_the_visible_part() {
+        let v = view();
+        // A floor-like quad running from behind the eye to far in front.
+        let quad = [
+            DVec3::new(-1.0, -1.0, 10.0),
+            DVec3::new(1.0, -1.0, 10.0),
+            DVec3::new(1.0, -1.0, -10.0),
+            DVec3::new(-1.0, -1.0, -10.0),
+        ];
+        let mut scratch = [Vec::new(), Vec::new()];
+        let mut out = Vec::new();
+        assert!(v.clip_project(&quad, &mut scratch, &mut out));
+        assert_eq!(out.len(), 4);
+        assert!(out.iter().all(|p| p.is_finite()));
+    }
+}

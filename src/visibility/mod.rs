@@ -1,0 +1,119 @@
+//! Visibility stages: which polygon is seen at each pixel centre. Every stage hands on the
+//! same thing, runs of equal polygon per scanline, so every shadow stage works behind any of
+//! them and they can be compared run for run.
+
+mod ray_cast;
+mod scanline;
+mod zbuffer;
+
+pub use ray_cast::RayCastVisibility;
+pub use scanline::ScanlineVisibility;
+pub use zbuffer::ZBufferVisibility;
+
+use crate::error::{Error, Result};
+use crate::scene::Scene;
+use crate::stats::Counters;
+use crate::view::{ScreenPolygon, View};
+use std::ops::Range;
+
+/// A run of pixels `x0..x1` on one scanline that all see scene polygon `poly`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Run {
+    /// First pixel.
+    pub x0: u32,
+    /// One past the last pixel.
+    pub x1: u32,
+    /// Index into [`Scene::polygons`].
+    pub poly: u32,
+}
+
+/// A prepared visibility stage.
+pub trait Visibility: Sync {
+    /// Walks `lines` in increasing order, calling `f(line, runs)` with each line's runs in
+    /// increasing x (lines with no runs included). Several bands may be walked at once.
+    fn walk(&self, lines: Range<u32>, counters: &mut Counters, f: &mut dyn FnMut(u32, &[Run]));
+}
+
+/// The visibility methods, chosen by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum VisibilityMethod {
+    /// Watkins' scanline algorithm with edge and active-edge tables.
+    Scanline,
+    /// Catmull's depth buffer.
+    ZBuffer,
+    /// One ray per pixel centre (the reference).
+    RayCast,
+}
+
+impl VisibilityMethod {
+    /// Every method.
+    pub const ALL: [VisibilityMethod; 3] = [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer, VisibilityMethod::RayCast];
+
+    /// The method's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            VisibilityMethod::Scanline => "scanline",
+            VisibilityMethod::ZBuffer => "zbuffer",
+            VisibilityMethod::RayCast => "ray-cast",
+        }
+    }
+
+    /// Prepares the stage for a view of `scene`; `screen` are the scene's screen polygons.
+    pub fn prepare<'a>(
+        self,
+        scene: &'a Scene,
+        view: &'a View,
+        screen: &'a [ScreenPolygon],
+        counters: &mut Counters,
+    ) -> Box<dyn Visibility + 'a> {
+        match self {
+            VisibilityMethod::Scanline => Box::new(ScanlineVisibility::new(screen, view, counters)),
+            VisibilityMethod::ZBuffer => Box::new(ZBufferVisibility::new(screen, view, counters)),
+            VisibilityMethod::RayCast => Box::new(RayCastVisibility::new(scene, view)),
+        }
+    }
+}
+
+impl std::str::FromStr for VisibilityMethod {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
+            Error::Invalid(format!("unknown visibility method '{s}' (known: {})", known.join(", ")))
+        })
+    }
+}
+
+impl std::fmt::Display for VisibilityMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Appends `x0..x1` seeing `poly` to `runs`, merging it with the last run when they join.
+#[inline]
+pub(crate) fn push_run(runs: &mut Vec<Run>, x0: u32, x1: u32, poly: u32) {
+    if let Some(last) = runs.last_mut() {
+        if last.poly == poly && last.x1 == x0 {
+            last.x1 = x1;
+            return;
+        }
+    }
+    runs.push(Run { x0, x1, poly });
+}
+
+/// Turns one line of per-pixel polygon indices (`u32::MAX` for none) into runs.
+pub(crate) fn runs_of_row(row: &[u32], runs: &mut Vec<Run>) {
+    runs.clear();
+    let mut x = 0;
+    while x < row.len() {
+        let p = row[x];
+        let start = x;
+        while x < row.len() && row[x] == p {
+            x += 1;
+        }
+        if p != u32::MAX {
+            runs.push(Run { x0: start as u32, x1: x as u32, poly: p });
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! Watkins' scanline hidden-surface algorithm (G. S. Watkins, "A real-time visible surface
+//! algorithm", Utah, 1970; see also Sutherland, Sproull & Schumacker 1974, §"Watkins").
+//!
+//! One [`EdgeTable`] holds the edges of every screen polygon, bucketed by their first line.
+//! Each line, the [`ActiveEdges`] give the crossings in x order; between two neighbouring
+//! crossings the set of polygons covering the line is constant (a *span*). For each span the
+//! nearest polygon is found at its two end samples. Inverse depth is linear in x along a
+//! line, so if one polygon is nearest at both ends it is nearest throughout; if not, the two
+//! winners' depths cross inside the span (interpenetration), and the span is split where they
+//! cross and each part is solved again — Watkins' subdivision.
+
+use super::{push_run, Run, Visibility};
+use crate::scan::{boundary, ActiveEdges, EdgeTable};
+use crate::stats::Counters;
+use crate::view::{ScreenPolygon, View};
+use std::ops::Range;
+
+/// The prepared scanline stage: the edge table of every screen polygon.
+pub struct ScanlineVisibility<'a> {
+    screen: &'a [ScreenPolygon],
+    table: EdgeTable,
+    width: u32,
+}
+
+impl<'a> ScanlineVisibility<'a> {
+    /// Builds the edge table of `screen`.
+    pub fn new(screen: &'a [ScreenPolygon], view: &View, counters: &mut Counters) -> Self {
+        let mut table = EdgeTable::new(view.height);
+        for (i, p) in screen.iter().enumerate() {
+            table.add_ring(i as u32, &p.ring);
+        }
+        table.finish();
+        counters.add("edges", table.len() as u64);
+        ScanlineVisibility { screen, table, width: view.width }
+    }
+}
+
+/// Per-band scratch and counters.
+struct Walk<'s> {
+    screen: &'s [ScreenPolygon],
+    yc: f64,
+    spans: u64,
+    splits: u64,
+    depth_tests: u64,
+}
+
+impl Walk<'_> {
+    /// The polygon of `set` nearest the eye at the centre of pixel `x` (ties: lowest index).
+    #[inline]
+    fn nearest(&mut self, set: &[u32], x: u32) -> u32 {
+        let xc = x as f64 + 0.5;
+        self.depth_tests += set.len() as u64;
+        let mut best = set[0];
+        let mut best_z = self.screen[best as usize].depth.inv_z(xc, self.yc);
+        for &i in &set[1..] {
+            let z = self.screen[i as usize].depth.inv_z(xc, self.yc);
+            if z > best_z || (z == best_z && i < best) {
+                best = i;
+                best_z = z;
+            }
+        }
+        best
+    }
+
+    /// Resolves span `a..b` covered by `set`, splitting it where the nearest polygon changes.
+    fn resolve(&mut self, set: &[u32], a: u32, b: u32, runs: &mut Vec<Run>) {
+        self.spans += 1;
+        let left = self.nearest(set, a);
+        let right = if b - a == 1 { left } else { self.nearest(set, b - 1) };
+        if left == right {
+            push_run(runs, a, b, self.screen[left as usize].poly);
+            return;
+        }
+        // The two winners' inverse depths are equal at x* (they interpenetrate there).
+        self.splits += 1;
+        let (l, r) = (&self.screen[left as usize].depth, &self.screen[right as usize].depth);
+        let x_star = ((r.b - l.b) * self.yc + (r.c - l.c)) / (l.a - r.a);
+        let m = if x_star.is_finite() { boundary(x_star, u32::MAX) } else { a + (b - a) / 2 };
+        let m = m.clamp(a + 1, b - 1);
+        self.resolve(set, a, m, runs);
+        self.resolve(set, m, b, runs);
+    }
+}
+
+impl Visibility for ScanlineVisibility<'_> {
+    fn walk(&self, lines: Range<u32>, counters: &mut Counters, f: &mut dyn FnMut(u32, &[Run])) {
+        let mut aet = ActiveEdges::new(&self.table, lines.clone());
+        let mut inside = vec![false; self.screen.len()];
+        let mut set: Vec<u32> = Vec::new();
+        let mut runs = Vec::new();
+        let mut walk = Walk { screen: self.screen, yc: 0.0, spans: 0, splits: 0, depth_tests: 0 };
+        let mut max_active = 0;
+        let mut next = lines.start;
+        let emit_empty_until = |upto: u32, next: &mut u32, f: &mut dyn FnMut(u32, &[Run])| {
+            while *next < upto {
+                f(*next, &[]);
+                *next += 1;
+            }
+        };
+        while let Some((line, xs)) = aet.next_line() {
+            emit_empty_until(line, &mut next, f);
+            walk.yc = line as f64 + 0.5;
+            max_active = max_active.max(xs.len());
+            runs.clear();
+            let mut prev = 0;
+            for c in xs {
+                let b = boundary(c.x, self.width);
+                if b > prev && !set.is_empty() {
+                    walk.resolve(&set, prev, b, &mut runs);
+                }
+                prev = prev.max(b);
+                let tag = c.tag as usize;
+                inside[tag] = !inside[tag];
+                if inside[tag] {
+                    set.push(c.tag);
+                } else if let Some(k) = set.iter().position(|&t| t == c.tag) {
+                    set.swap_remove(k);
+                }
+            }
+            // Every polygon's crossings pair up, so the set is empty again here.
+            debug_assert!(set.is_empty());
+            f(line, &runs);
+            next = line + 1;
+        }
+        emit_empty_until(lines.end, &mut next, f);
+        counters.add("edges_entered", aet.entered);
+        counters.add("spans", walk.spans);
+        counters.add("span_splits", walk.splits);
+        counters.add("depth_tests", walk.depth_tests);
+        counters.add("active_edges_max", max_active as u64);
+    }
+}
