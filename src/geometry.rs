@@ -15,7 +15,10 @@ pub struct Plane {
 impl Plane {
     /// The plane through `point` with unit normal `n`.
     pub fn new(n: DVec3, point: DVec3) -> Self {
-        Plane { n, d: -n.dot(point) }
+        Plane {
+            n,
+            d: -n.dot(point),
+        }
     }
 
     /// Signed distance of `p` from the plane (positive on the front side).
@@ -78,7 +81,11 @@ pub fn classify_face(verts: &[DVec3]) -> FaceShape {
     }
     let v: Vec<DVec3> = idx.iter().map(|&i| verts[i]).collect();
     let mut distinct = v.clone();
-    distinct.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).unwrap_or(std::cmp::Ordering::Equal));
+    distinct.sort_by(|a, b| {
+        a.to_array()
+            .partial_cmp(&b.to_array())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
     distinct.dedup();
     if distinct.len() < 3 {
         return FaceShape::Degenerate;
@@ -141,7 +148,9 @@ pub fn clip_polygon(poly: &[DVec3], dist: impl Fn(DVec3) -> f64, out: &mut Vec<D
 /// point is inside a span `[x_left, x_right)` that the crossings bound.
 pub fn inside_even_odd(ring: &[DVec2], p: DVec2) -> bool {
     let mut inside = false;
-    let Some(&last) = ring.last() else { return false };
+    let Some(&last) = ring.last() else {
+        return false;
+    };
     let mut a = last;
     for &b in ring {
         let (top, bot) = if a.y <= b.y { (a, b) } else { (b, a) };
@@ -224,7 +233,12 @@ mod tests {
 
     #[test]
     fn even_odd_inside() {
-        let ring = [DVec2::ZERO, DVec2::new(4.0, 0.0), DVec2::new(4.0, 4.0), DVec2::new(0.0, 4.0)];
+        let ring = [
+            DVec2::ZERO,
+            DVec2::new(4.0, 0.0),
+            DVec2::new(4.0, 4.0),
+            DVec2::new(0.0, 4.0),
+        ];
         assert!(inside_even_odd(&ring, DVec2::new(2.0, 2.0)));
         assert!(!inside_even_odd(&ring, DVec2::new(5.0, 2.0)));
         assert!(inside_even_odd(&ring, DVec2::new(0.0, 0.0)));

@@ -6,7 +6,11 @@ use std::process::ExitCode;
 use umbra::{generate, render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 #[derive(Parser)]
-#[command(name = "umbra", version, about = "Classic scanline hidden-surface and shadow algorithms, reproduced and measured")]
+#[command(
+    name = "umbra",
+    version,
+    about = "Classic scanline hidden-surface and shadow algorithms, reproduced and measured"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -97,14 +101,22 @@ fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
             let scene = Scene::load(&a.scene)?;
-            let opts = RenderOptions { visibility: a.visibility, shadows: a.shadows, progress: true };
+            let opts = RenderOptions {
+                visibility: a.visibility,
+                shadows: a.shadows,
+                progress: true,
+            };
             let out = render(&scene, &opts)?;
             out.frame.save_png(&a.output, a.gamma)?;
             if let Some(dir) = &a.aov {
                 out.frame.save_aovs(dir)?;
             }
             if a.stats {
-                println!("{}", serde_json::to_string(&out.stats).map_err(|e| umbra::Error::Invalid(e.to_string()))?);
+                println!(
+                    "{}",
+                    serde_json::to_string(&out.stats)
+                        .map_err(|e| umbra::Error::Invalid(e.to_string()))?
+                );
             }
             Ok(())
         }

@@ -33,7 +33,11 @@ pub struct RenderOptions {
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { visibility: VisibilityMethod::Scanline, shadows: ShadowMethod::DEFAULT, progress: false }
+        RenderOptions {
+            visibility: VisibilityMethod::Scanline,
+            shadows: ShadowMethod::DEFAULT,
+            progress: false,
+        }
     }
 }
 
@@ -83,11 +87,15 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
 
     let t = Instant::now();
     let screen = view.screen_polygons(scene);
-    stats.visibility_counters.add("screen_polygons", screen.len() as u64);
+    stats
+        .visibility_counters
+        .add("screen_polygons", screen.len() as u64);
     stats.time_ms.insert("view", ms(t.elapsed()));
 
     let t = Instant::now();
-    let visibility = opts.visibility.prepare(scene, &view, &screen, &mut stats.visibility_counters);
+    let visibility = opts
+        .visibility
+        .prepare(scene, &view, &screen, &mut stats.visibility_counters);
     stats.time_ms.insert("visibility_prepare", ms(t.elapsed()));
 
     let t = Instant::now();
@@ -184,14 +192,22 @@ struct Progress {
 
 impl Progress {
     fn new(enabled: bool, total: u64) -> Self {
-        Progress { bar: None, enabled: enabled && std::io::stderr().is_terminal(), start: Instant::now(), done: 0, total }
+        Progress {
+            bar: None,
+            enabled: enabled && std::io::stderr().is_terminal(),
+            start: Instant::now(),
+            done: 0,
+            total,
+        }
     }
 
     fn advance(&mut self, n: u64) {
         self.done += n;
         if self.bar.is_none() && self.enabled && self.start.elapsed() > Duration::from_secs(1) {
             let bar = ProgressBar::with_draw_target(Some(self.total), ProgressDrawTarget::stderr());
-            if let Ok(style) = ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} lines {elapsed}") {
+            if let Ok(style) =
+                ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} lines {elapsed}")
+            {
                 bar.set_style(style);
             }
             bar.set_message("rendering");

@@ -71,7 +71,10 @@ pub struct EdgeTable {
 impl EdgeTable {
     /// An empty table for an image `height` lines high.
     pub fn new(height: u32) -> Self {
-        EdgeTable { height, ..Default::default() }
+        EdgeTable {
+            height,
+            ..Default::default()
+        }
     }
 
     /// Empties the table, keeping its memory, for an image `height` lines high.
@@ -107,7 +110,14 @@ impl EdgeTable {
             return;
         }
         let dxdy = (bot.x - top.x) / (bot.y - top.y);
-        self.edges.push(Edge { x_top: top.x, y_top: top.y, dxdy, first, end, tag });
+        self.edges.push(Edge {
+            x_top: top.x,
+            y_top: top.y,
+            dxdy,
+            first,
+            end,
+            tag,
+        });
     }
 
     /// Sorts the edges into buckets by first line (a counting sort). Call it after the last
@@ -187,7 +197,10 @@ impl<'a> ActiveEdges<'a> {
     /// Walks a finished `table` over `lines` (clamped to the lines the table covers). A range
     /// that starts below the table's first line picks up the edges already active there.
     pub fn new(table: &'a EdgeTable, lines: Range<u32>) -> ActiveEdges<'a> {
-        debug_assert!(table.built, "EdgeTable::finish must be called before walking");
+        debug_assert!(
+            table.built,
+            "EdgeTable::finish must be called before walking"
+        );
         let start = lines.start.max(table.lines.start);
         let end = lines.end.min(table.lines.end);
         let mut active = Vec::new();
@@ -199,7 +212,14 @@ impl<'a> ActiveEdges<'a> {
                 }
             }
         }
-        ActiveEdges { table, next: start, end, active, out: Vec::new(), entered: 0 }
+        ActiveEdges {
+            table,
+            next: start,
+            end,
+            active,
+            out: Vec::new(),
+            entered: 0,
+        }
     }
 
     /// Advances to the next line: its index and its crossings in increasing x.
@@ -211,9 +231,15 @@ impl<'a> ActiveEdges<'a> {
         self.next += 1;
         let edges = &self.table.edges;
         self.active.retain(|&(_, i)| edges[i as usize].end > line);
-        let base = self.table.bucket.get((line - self.table.lines.start) as usize).copied().unwrap_or(0);
+        let base = self
+            .table
+            .bucket
+            .get((line - self.table.lines.start) as usize)
+            .copied()
+            .unwrap_or(0);
         for (k, e) in self.table.starting_on(line).iter().enumerate() {
-            self.active.push((Crossing { x: 0.0, tag: e.tag }, base + k as u32));
+            self.active
+                .push((Crossing { x: 0.0, tag: e.tag }, base + k as u32));
             self.entered += 1;
         }
         for (c, i) in &mut self.active {
@@ -280,15 +306,28 @@ mod tests {
 
     #[test]
     fn square_covers_the_pixel_centres_inside() {
-        let sq = [DVec2::new(1.0, 1.0), DVec2::new(4.0, 1.0), DVec2::new(4.0, 3.0), DVec2::new(1.0, 3.0)];
+        let sq = [
+            DVec2::new(1.0, 1.0),
+            DVec2::new(4.0, 1.0),
+            DVec2::new(4.0, 3.0),
+            DVec2::new(1.0, 3.0),
+        ];
         assert_eq!(spans(&sq, 8, 8), vec![(1, 1, 4), (2, 1, 4)]);
     }
 
     #[test]
     fn shared_edges_cover_each_centre_once() {
         // Two triangles sharing a diagonal tile a square: every centre covered exactly once.
-        let a = [DVec2::new(0.0, 0.0), DVec2::new(7.3, 0.0), DVec2::new(0.0, 5.9)];
-        let b = [DVec2::new(7.3, 0.0), DVec2::new(7.3, 5.9), DVec2::new(0.0, 5.9)];
+        let a = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(7.3, 0.0),
+            DVec2::new(0.0, 5.9),
+        ];
+        let b = [
+            DVec2::new(7.3, 0.0),
+            DVec2::new(7.3, 5.9),
+            DVec2::new(0.0, 5.9),
+        ];
         let mut count = [[0; 8]; 6];
         for (y, x0, x1) in spans(&a, 8, 6).into_iter().chain(spans(&b, 8, 6)) {
             for x in x0..x1 {
@@ -302,7 +341,11 @@ mod tests {
 
     #[test]
     fn band_start_picks_up_active_edges() {
-        let tri = [DVec2::new(0.0, 0.0), DVec2::new(10.0, 10.0), DVec2::new(0.0, 10.0)];
+        let tri = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(10.0, 10.0),
+            DVec2::new(0.0, 10.0),
+        ];
         let mut t = EdgeTable::new(10);
         t.add_ring(0, &tri);
         t.finish();
@@ -322,7 +365,11 @@ mod tests {
     #[test]
     fn long_thin_edges_do_not_drift() {
         // A sliver 1e5 pixels long: each line's crossing equals the exact interpolation.
-        let ring = [DVec2::new(0.0, 0.0), DVec2::new(1e5, 1000.0), DVec2::new(0.0, 0.3)];
+        let ring = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1e5, 1000.0),
+            DVec2::new(0.0, 0.3),
+        ];
         let mut t = EdgeTable::new(1000);
         t.add_ring(0, &ring);
         t.finish();

@@ -45,7 +45,10 @@ pub fn parse_obj(text: &str, file: &Path) -> Result<Mesh> {
                         return Err(Error::input(loc(), format!("bad face vertex '{w}'")));
                     }
                     let Some(v) = got[0] else {
-                        return Err(Error::input(loc(), format!("face vertex '{w}' has no vertex index")));
+                        return Err(Error::input(
+                            loc(),
+                            format!("face vertex '{w}' has no vertex index"),
+                        ));
                     };
                     face.vertices.push(v);
                     match got[2] {
@@ -72,12 +75,19 @@ fn number(word: &str, what: &str, loc: &impl Fn() -> FileLoc) -> Result<f64> {
         .parse()
         .map_err(|_| Error::input(loc(), format!("bad number '{word}' in '{what}'")))?;
     if !x.is_finite() {
-        return Err(Error::input(loc(), format!("non-finite number '{word}' in '{what}'")));
+        return Err(Error::input(
+            loc(),
+            format!("non-finite number '{word}' in '{what}'"),
+        ));
     }
     Ok(x)
 }
 
-fn vec3<'a>(words: &mut impl Iterator<Item = &'a str>, what: &str, loc: &impl Fn() -> FileLoc) -> Result<DVec3> {
+fn vec3<'a>(
+    words: &mut impl Iterator<Item = &'a str>,
+    what: &str,
+    loc: &impl Fn() -> FileLoc,
+) -> Result<DVec3> {
     let mut c = [0.0; 3];
     for x in &mut c {
         let w = words
@@ -122,7 +132,10 @@ mod tests {
         assert_eq!(m.faces.len(), 3);
         assert_eq!(m.faces[1].vertices, vec![0, 1, 2]);
         assert_eq!(m.faces[1].normals, vec![0, 0, 0]);
-        assert!(m.faces[2].normals.is_empty(), "normals only when every vertex has one");
+        assert!(
+            m.faces[2].normals.is_empty(),
+            "normals only when every vertex has one"
+        );
     }
 
     #[test]

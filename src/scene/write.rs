@@ -28,13 +28,28 @@ impl Scene {
         let c = &self.camera;
         let mut t = String::new();
         // Writing into a String cannot fail.
-        let _ = writeln!(t, "# written by umbra\n[camera]\neye = {}\ntarget = {}\nup = {}", d3(c.eye), d3(c.target), d3(c.up));
-        let _ = writeln!(t, "fov_y = {:?}\nwidth = {}\nheight = {}\nnear = {:?}", c.fov_y, c.width, c.height, c.near);
+        let _ = writeln!(
+            t,
+            "# written by umbra\n[camera]\neye = {}\ntarget = {}\nup = {}",
+            d3(c.eye),
+            d3(c.target),
+            d3(c.up)
+        );
+        let _ = writeln!(
+            t,
+            "fov_y = {:?}\nwidth = {}\nheight = {}\nnear = {:?}",
+            c.fov_y, c.width, c.height, c.near
+        );
         if let Some(far) = c.far {
             let _ = writeln!(t, "far = {far:?}");
         }
         let r = &self.render;
-        let _ = writeln!(t, "\n[render]\nambient = {}\nbackground = {}", f3(r.ambient), f3(r.background));
+        let _ = writeln!(
+            t,
+            "\n[render]\nambient = {}\nbackground = {}",
+            f3(r.ambient),
+            f3(r.background)
+        );
         for m in &self.materials {
             let model = match m.model {
                 SpecularModel::Phong => "phong",
@@ -61,7 +76,12 @@ impl Scene {
                 LightKind::Directional { direction } => {
                     let _ = writeln!(t, "kind = \"directional\"\ndirection = {}", d3(direction));
                 }
-                LightKind::Spot { position, direction, cutoff, exponent } => {
+                LightKind::Spot {
+                    position,
+                    direction,
+                    cutoff,
+                    exponent,
+                } => {
                     let _ = writeln!(
                         t,
                         "kind = \"spot\"\nposition = {}\ndirection = {}\ncutoff = {cutoff:?}\nexponent = {exponent:?}",
@@ -69,7 +89,12 @@ impl Scene {
                         d3(direction)
                     );
                 }
-                LightKind::Area { corner, edge_u, edge_v, samples } => {
+                LightKind::Area {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    samples,
+                } => {
                     let _ = writeln!(
                         t,
                         "kind = \"area\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nsamples = [{}, {}]",
@@ -82,7 +107,15 @@ impl Scene {
                 }
             }
             let a = l.attenuation;
-            let _ = writeln!(t, "color = {}\nintensity = {:?}\nattenuation = [{:?}, {:?}, {:?}]", f3(l.color), l.intensity, a[0], a[1], a[2]);
+            let _ = writeln!(
+                t,
+                "color = {}\nintensity = {:?}\nattenuation = [{:?}, {:?}, {:?}]",
+                f3(l.color),
+                l.intensity,
+                a[0],
+                a[1],
+                a[2]
+            );
         }
         for (i, o) in self.objects.iter().enumerate() {
             let mesh_name = format!("meshes/{stem}_{i}.obj");

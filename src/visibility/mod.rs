@@ -47,7 +47,11 @@ pub enum VisibilityMethod {
 
 impl VisibilityMethod {
     /// Every method.
-    pub const ALL: [VisibilityMethod; 3] = [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer, VisibilityMethod::RayCast];
+    pub const ALL: [VisibilityMethod; 3] = [
+        VisibilityMethod::Scanline,
+        VisibilityMethod::ZBuffer,
+        VisibilityMethod::RayCast,
+    ];
 
     /// The method's name on the command line.
     pub fn name(self) -> &'static str {
@@ -77,10 +81,16 @@ impl VisibilityMethod {
 impl std::str::FromStr for VisibilityMethod {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
-            let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
-            Error::Invalid(format!("unknown visibility method '{s}' (known: {})", known.join(", ")))
-        })
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
+                Error::Invalid(format!(
+                    "unknown visibility method '{s}' (known: {})",
+                    known.join(", ")
+                ))
+            })
     }
 }
 
@@ -113,7 +123,11 @@ pub(crate) fn runs_of_row(row: &[u32], runs: &mut Vec<Run>) {
             x += 1;
         }
         if p != u32::MAX {
-            runs.push(Run { x0: start as u32, x1: x as u32, poly: p });
+            runs.push(Run {
+                x0: start as u32,
+                x1: x as u32,
+                poly: p,
+            });
         }
     }
 }

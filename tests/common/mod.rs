@@ -1,0 +1,92 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use umbra::{render, Frame, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
+
+/// Every scene file in `scenes/`.
+pub fn scene_files() -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("scenes/ exists")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    v.sort();
+    assert!(v.len() >= 5, "scenes/ should hold the example scenes");
+    v
+}
+
+/// Loads a scene and shrinks its image to at most `max_width` pixels wide (same aspect).
+pub fn load_scaled(path: &PathBuf, max_width: u32) -> Scene {
+    let mut s = Scene::load(path).unwrap_or_else(|e| panic!("{e}"));
+    if s.camera.width > max_width {
+        let h = (s.camera.height as u64 * max_width as u64 / s.camera.width as u64).max(1) as u32;
+        s.camera.width = max_width;
+        s.camera.height = h;
+    }
+    s
+}
+
+pub fn frame(scene: &Scene, visibility: VisibilityMethod, shadows: ShadowMethod) -> Frame {
+    let opts = RenderOptions {
+        visibility,
+        shadows,
+        progress: false,
+    };
+    render(scene, &opts).unwrap_or_else(|e| panic!("{e}")).frame
+}
+
+/// Asserts that `got` sees the same face as `reference` at every pixel whose 3x3
+/// neighbourhood in `reference` has one face id. Returns the number of pixels compared.
+pub fn assert_ids_agree(reference: &Frame, got: &Frame, label: &str) -> usize {
+    let mut compared = 0;
+    let mut bad = Vec::new();
+    for y in 0..reference.height {
+        for x in 0..reference.width {
+            if !reference.is_id_interior(x, y) {
+                continue;
+            }
+            compared += 1;
+            let k = (y * reference.width + x) as usize;
+            if reference.id[k] != got.id[k] {
+                bad.push((x, y, reference.id[k], got.id[k]));
+            }
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "{label}: {} of {compared} interior pixels differ in id (x, y, want, got): {:?}",
+        bad.len(),
+        &bad[..bad.len().min(10)]
+    );
+    compared
+}
+
+/// Asserts that `got` has the same face id and lit fraction of every light as `reference`
+/// at every pixel whose 3x3 neighbourhood in `reference` is uniform in id and light values.
+pub fn assert_light_agree(reference: &Frame, got: &Frame, label: &str) -> usize {
+    let mut compared = 0;
+    let mut bad = Vec::new();
+    for y in 0..reference.height {
+        for x in 0..reference.width {
+            if !reference.is_interior(x, y) {
+                continue;
+            }
+            compared += 1;
+            let k = (y * reference.width + x) as usize;
+            for (l, (a, b)) in reference.light.iter().zip(&got.light).enumerate() {
+                if reference.id[k] != got.id[k] || a[k] != b[k] {
+                    bad.push((x, y, l, a[k], b[k]));
+                }
+            }
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "{label}: {} of {compared} interior pixels differ (x, y, light, want, got): {:?}",
+        bad.len(),
+        &bad[..bad.len().min(10)]
+    );
+    compared
+}
