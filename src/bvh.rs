@@ -26,27 +26,16 @@ const LEAF: usize = 4;
 
 fn bounds(scene: &Scene, i: u32) -> (DVec3, DVec3) {
     let v = scene.verts(i as usize);
-    v.iter()
-        .fold((v[0], v[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    v.iter().fold((v[0], v[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)))
 }
 
 impl Bvh {
     /// Builds the hierarchy over polygons `items` of `scene`.
     pub fn new(scene: &Scene, items: Vec<u32>) -> Bvh {
-        let boxes: Vec<(DVec3, DVec3)> = (0..scene.polygons.len() as u32)
-            .map(|i| bounds(scene, i))
-            .collect();
-        let mut bvh = Bvh {
-            nodes: Vec::with_capacity(2 * items.len() / LEAF + 1),
-            items,
-        };
+        let boxes: Vec<(DVec3, DVec3)> = (0..scene.polygons.len() as u32).map(|i| bounds(scene, i)).collect();
+        let mut bvh = Bvh { nodes: Vec::with_capacity(2 * items.len() / LEAF + 1), items };
         if !bvh.items.is_empty() {
-            bvh.nodes.push(Node {
-                lo: DVec3::ZERO,
-                hi: DVec3::ZERO,
-                first: 0,
-                count: 0,
-            });
+            bvh.nodes.push(Node { lo: DVec3::ZERO, hi: DVec3::ZERO, first: 0, count: 0 });
             let n = bvh.items.len();
             bvh.build(&boxes, 0, 0, n);
         }
@@ -87,12 +76,7 @@ impl Bvh {
         };
         items.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
         let left = self.nodes.len();
-        let empty = Node {
-            lo: DVec3::ZERO,
-            hi: DVec3::ZERO,
-            first: 0,
-            count: 0,
-        };
+        let empty = Node { lo: DVec3::ZERO, hi: DVec3::ZERO, first: 0, count: 0 };
         self.nodes.push(empty);
         self.nodes.push(empty);
         self.nodes[node].first = left as u32;
@@ -103,14 +87,7 @@ impl Bvh {
 
     /// Walks the leaves whose boxes the ray `o + t d`, `t in (tmin, tmax)` meets; `f` gets each
     /// polygon and returns a new `tmax` (or `None` to stop the walk).
-    fn walk(
-        &self,
-        o: DVec3,
-        d: DVec3,
-        tmin: f64,
-        mut tmax: f64,
-        mut f: impl FnMut(u32, f64) -> Option<f64>,
-    ) {
+    fn walk(&self, o: DVec3, d: DVec3, tmin: f64, mut tmax: f64, mut f: impl FnMut(u32, f64) -> Option<f64>) {
         if self.nodes.is_empty() {
             return;
         }
@@ -148,14 +125,7 @@ impl Bvh {
     }
 
     /// The nearest polygon hit by `o + t d` with `t in [tmin, tmax]`, and its `t`.
-    pub fn closest(
-        &self,
-        scene: &Scene,
-        o: DVec3,
-        d: DVec3,
-        tmin: f64,
-        tmax: f64,
-    ) -> Option<(u32, f64)> {
+    pub fn closest(&self, scene: &Scene, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<(u32, f64)> {
         let mut best: Option<(u32, f64)> = None;
         self.walk(o, d, tmin, tmax, |i, tmax| {
             match hit(scene, i as usize, o, d) {
@@ -174,15 +144,7 @@ impl Bvh {
 
     /// Whether any polygon other than those of face `skip_face` meets `o + t d` with
     /// `t in (tmin, tmax)`.
-    pub fn occluded(
-        &self,
-        scene: &Scene,
-        o: DVec3,
-        d: DVec3,
-        tmin: f64,
-        tmax: f64,
-        skip_face: u32,
-    ) -> bool {
+    pub fn occluded(&self, scene: &Scene, o: DVec3, d: DVec3, tmin: f64, tmax: f64, skip_face: u32) -> bool {
         let mut found = false;
         self.walk(o, d, tmin, tmax, |i, tmax| {
             if scene.polygons[i as usize].face == skip_face {

@@ -18,20 +18,12 @@ pub struct FileLoc {
 impl FileLoc {
     /// A whole file, with no line.
     pub fn file(file: impl Into<PathBuf>) -> Self {
-        FileLoc {
-            file: file.into(),
-            line: None,
-            column: None,
-        }
+        FileLoc { file: file.into(), line: None, column: None }
     }
 
     /// A line of a file.
     pub fn line(file: impl Into<PathBuf>, line: usize) -> Self {
-        FileLoc {
-            file: file.into(),
-            line: Some(line),
-            column: None,
-        }
+        FileLoc { file: file.into(), line: Some(line), column: None }
     }
 
     /// The place of byte `offset` in `source`, the text of `file`.
@@ -39,17 +31,8 @@ impl FileLoc {
         let offset = offset.min(source.len());
         let before = &source.as_bytes()[..offset];
         let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-        let column = offset
-            - before
-                .iter()
-                .rposition(|&b| b == b'\n')
-                .map_or(0, |p| p + 1)
-            + 1;
-        FileLoc {
-            file: file.into(),
-            line: Some(line),
-            column: Some(column),
-        }
+        let column = offset - before.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1) + 1;
+        FileLoc { file: file.into(), line: Some(line), column: Some(column) }
     }
 }
 
@@ -102,10 +85,7 @@ pub enum Error {
 impl Error {
     /// An input error at `loc`.
     pub fn input(loc: FileLoc, message: impl Into<String>) -> Self {
-        Error::Input {
-            loc,
-            message: message.into(),
-        }
+        Error::Input { loc, message: message.into() }
     }
 }
 

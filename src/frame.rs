@@ -27,21 +27,12 @@ impl Frame {
     /// A frame of background pixels.
     pub fn new(width: u32, height: u32, lights: usize, background: Vec3) -> Frame {
         let n = width as usize * height as usize;
-        Frame {
-            width,
-            height,
-            color: vec![background; n],
-            id: vec![BACKGROUND; n],
-            light: vec![vec![0.0; n]; lights],
-        }
+        Frame { width, height, color: vec![background; n], id: vec![BACKGROUND; n], light: vec![vec![0.0; n]; lights] }
     }
 
     fn save(&self, img: image::DynamicImage, path: &Path) -> Result<()> {
         img.save_with_format(path, image::ImageFormat::Png)
-            .map_err(|e| Error::Image {
-                path: path.to_owned(),
-                source: e,
-            })
+            .map_err(|e| Error::Image { path: path.to_owned(), source: e })
     }
 
     /// The colour image, clamped to [0, 1], optionally raised to `1/gamma` for display.
@@ -67,9 +58,7 @@ impl Frame {
     /// `light<k>.png`: `round(255 * lit fraction)`.
     pub fn light_image(&self, k: usize) -> image::GrayImage {
         image::GrayImage::from_fn(self.width, self.height, |x, y| {
-            image::Luma([
-                (255.0 * self.light[k][(y * self.width + x) as usize] as f64).round() as u8,
-            ])
+            image::Luma([(255.0 * self.light[k][(y * self.width + x) as usize] as f64).round() as u8])
         })
     }
 
@@ -80,16 +69,10 @@ impl Frame {
 
     /// Writes `id.png` and `light<k>.png` into `dir` (created if missing).
     pub fn save_aovs(&self, dir: &Path) -> Result<()> {
-        std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-            path: dir.to_owned(),
-            source: e,
-        })?;
+        std::fs::create_dir_all(dir).map_err(|e| Error::Io { path: dir.to_owned(), source: e })?;
         self.save(self.id_image().into(), &dir.join("id.png"))?;
         for k in 0..self.light.len() {
-            self.save(
-                self.light_image(k).into(),
-                &dir.join(format!("light{k}.png")),
-            )?;
+            self.save(self.light_image(k).into(), &dir.join(format!("light{k}.png")))?;
         }
         Ok(())
     }

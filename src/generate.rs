@@ -2,9 +2,7 @@
 //! quads of depth complexity D, tessellated spheres) and random test scenes.
 
 use crate::error::Result;
-use crate::scene::{
-    Camera, Light, LightKind, Material, Mesh, Object, RenderSettings, Scene, Transform,
-};
+use crate::scene::{Camera, Light, LightKind, Material, Mesh, Object, RenderSettings, Scene, Transform};
 use glam::{DVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -23,27 +21,15 @@ fn object(material: usize, mesh: Mesh) -> Object {
 }
 
 fn material(name: &str, color: [f32; 3]) -> Material {
-    Material {
-        color: Vec3::from_array(color),
-        ..Material::new(name)
-    }
+    Material { color: Vec3::from_array(color), ..Material::new(name) }
 }
 
 fn point_light(p: DVec3) -> Light {
-    Light {
-        kind: LightKind::Point { position: p },
-        color: Vec3::ONE,
-        intensity: 1.0,
-        attenuation: [1.0, 0.0, 0.0],
-    }
+    Light { kind: LightKind::Point { position: p }, color: Vec3::ONE, intensity: 1.0, attenuation: [1.0, 0.0, 0.0] }
 }
 
 fn camera(eye: DVec3, target: DVec3, width: u32, height: u32) -> Camera {
-    Camera {
-        width,
-        height,
-        ..Camera::new(eye, target)
-    }
+    Camera { width, height, ..Camera::new(eye, target) }
 }
 
 /// Appends an axis-aligned box `lo..hi` to `mesh`, as 6 quads or 12 triangles.
@@ -56,32 +42,16 @@ fn add_box(mesh: &mut Mesh, lo: DVec3, hi: DVec3, triangles: bool) {
         )
     };
     // Counter-clockwise seen from outside.
-    const QUADS: [[usize; 4]; 6] = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
+    const QUADS: [[usize; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let base = mesh.positions.len() as u32;
     mesh.positions.extend((0..8).map(c));
     for q in QUADS {
         let q = q.map(|i| base + i as u32);
         if triangles {
-            mesh.faces.push(crate::scene::Face {
-                vertices: vec![q[0], q[1], q[2]],
-                normals: vec![],
-            });
-            mesh.faces.push(crate::scene::Face {
-                vertices: vec![q[0], q[2], q[3]],
-                normals: vec![],
-            });
+            mesh.faces.push(crate::scene::Face { vertices: vec![q[0], q[1], q[2]], normals: vec![] });
+            mesh.faces.push(crate::scene::Face { vertices: vec![q[0], q[2], q[3]], normals: vec![] });
         } else {
-            mesh.faces.push(crate::scene::Face {
-                vertices: q.to_vec(),
-                normals: vec![],
-            });
+            mesh.faces.push(crate::scene::Face { vertices: q.to_vec(), normals: vec![] });
         }
     }
 }
@@ -105,27 +75,14 @@ pub fn cubes(n: u32, triangles: bool, width: u32, height: u32) -> Result<Scene> 
             let x = -(n as f64) + 1.0 + 2.0 * i as f64;
             let z = -(n as f64) + 1.0 + 2.0 * j as f64;
             let h = 1.0 + ((i * 7 + j * 3) % 5) as f64 * 0.25;
-            add_box(
-                &mut boxes,
-                DVec3::new(x - 0.5, 0.0, z - 0.5),
-                DVec3::new(x + 0.5, h, z + 0.5),
-                triangles,
-            );
+            add_box(&mut boxes, DVec3::new(x - 0.5, 0.0, z - 0.5), DVec3::new(x + 0.5, h, z + 0.5), triangles);
         }
     }
     let s = n as f64;
     Scene::new(
-        camera(
-            DVec3::new(0.3 * s, 1.1 * s + 2.0, 1.6 * s + 3.0),
-            DVec3::ZERO,
-            width,
-            height,
-        ),
+        camera(DVec3::new(0.3 * s, 1.1 * s + 2.0, 1.6 * s + 3.0), DVec3::ZERO, width, height),
         RenderSettings::default(),
-        vec![
-            material("floor", [0.8, 0.8, 0.8]),
-            material("box", [0.9, 0.5, 0.3]),
-        ],
+        vec![material("floor", [0.8, 0.8, 0.8]), material("box", [0.9, 0.5, 0.3])],
         vec![point_light(DVec3::new(-0.6 * s, 1.5 * s + 3.0, 0.4 * s))],
         vec![object(0, floor(half)), object(1, boxes)],
     )
@@ -151,12 +108,7 @@ pub fn stacked_quads(d: u32, width: u32, height: u32) -> Result<Scene> {
         ]);
     }
     Scene::new(
-        camera(
-            DVec3::new(0.0, 0.0, 10.0),
-            DVec3::new(0.0, 0.0, 0.0),
-            width,
-            height,
-        ),
+        camera(DVec3::new(0.0, 0.0, 10.0), DVec3::new(0.0, 0.0, 0.0), width, height),
         RenderSettings::default(),
         vec![material("quad", [0.7, 0.7, 0.9])],
         vec![point_light(DVec3::new(3.0, 4.0, 8.0))],
@@ -187,12 +139,8 @@ pub fn sphere_mesh(c: DVec3, r: f64, triangles: u32) -> Mesh {
         }
     }
     let v = |i: u32, j: u32| 2 + (i - 1) * slices + (j % slices);
-    let mut tri = |a: u32, b: u32, c: u32| {
-        m.faces.push(crate::scene::Face {
-            vertices: vec![a, b, c],
-            normals: vec![a, b, c],
-        })
-    };
+    let mut tri =
+        |a: u32, b: u32, c: u32| m.faces.push(crate::scene::Face { vertices: vec![a, b, c], normals: vec![a, b, c] });
     for j in 0..slices {
         tri(0, v(1, j + 1), v(1, j));
         tri(1, v(stacks - 1, j), v(stacks - 1, j + 1));
@@ -213,50 +161,29 @@ pub fn spheres(triangles: u32, count: u32, width: u32, height: u32) -> Result<Sc
     let mut mesh = Mesh::default();
     for k in 0..count {
         let (i, j) = (k % side, k / side);
-        let r = if count == 1 {
-            1.0
-        } else {
-            rng.gen_range(0.3..0.6)
-        };
-        let jitter = if count == 1 {
-            DVec3::ZERO
-        } else {
-            DVec3::new(rng.gen_range(-0.3..0.3), 0.0, rng.gen_range(-0.3..0.3))
-        };
-        let c = DVec3::new(
-            2.0 * i as f64 - side as f64 + 1.0,
-            r,
-            2.0 * j as f64 - side as f64 + 1.0,
-        ) + jitter;
+        let r = if count == 1 { 1.0 } else { rng.gen_range(0.3..0.6) };
+        let jitter =
+            if count == 1 { DVec3::ZERO } else { DVec3::new(rng.gen_range(-0.3..0.3), 0.0, rng.gen_range(-0.3..0.3)) };
+        let c = DVec3::new(2.0 * i as f64 - side as f64 + 1.0, r, 2.0 * j as f64 - side as f64 + 1.0) + jitter;
         let s = sphere_mesh(c, r, triangles / count);
         let base = mesh.positions.len() as u32;
         let nbase = mesh.normals.len() as u32;
         mesh.positions.extend(s.positions);
         mesh.normals.extend(s.normals);
-        mesh.faces
-            .extend(s.faces.into_iter().map(|f| crate::scene::Face {
-                vertices: f.vertices.iter().map(|v| v + base).collect(),
-                normals: f.normals.iter().map(|v| v + nbase).collect(),
-            }));
+        mesh.faces.extend(s.faces.into_iter().map(|f| crate::scene::Face {
+            vertices: f.vertices.iter().map(|v| v + base).collect(),
+            normals: f.normals.iter().map(|v| v + nbase).collect(),
+        }));
     }
     let s = side as f64;
     let mut ball = material("sphere", [0.4, 0.6, 0.9]);
     ball.shading = crate::scene::ShadingMode::Phong;
     ball.ks = 0.4;
     Scene::new(
-        camera(
-            DVec3::new(0.0, 1.2 * s + 1.0, 1.8 * s + 2.0),
-            DVec3::new(0.0, 0.3, 0.0),
-            width,
-            height,
-        ),
+        camera(DVec3::new(0.0, 1.2 * s + 1.0, 1.8 * s + 2.0), DVec3::new(0.0, 0.3, 0.0), width, height),
         RenderSettings::default(),
         vec![material("floor", [0.8, 0.8, 0.8]), ball],
-        vec![point_light(DVec3::new(
-            -1.0 * s - 1.0,
-            2.0 * s + 2.0,
-            0.5 * s + 1.0,
-        ))],
+        vec![point_light(DVec3::new(-s - 1.0, 2.0 * s + 2.0, 0.5 * s + 1.0))],
         vec![object(0, floor(s + 1.0)), object(1, mesh)],
     )
 }
@@ -274,11 +201,7 @@ pub struct RandomOptions {
 
 impl Default for RandomOptions {
     fn default() -> Self {
-        RandomOptions {
-            polygons: 8,
-            width: 48,
-            height: 36,
-        }
+        RandomOptions { polygons: 8, width: 48, height: 36 }
     }
 }
 
@@ -294,37 +217,21 @@ pub fn random(seed: u64, opts: RandomOptions) -> Result<Scene> {
         DVec3::new(4.0, 0.0, 4.0),
         DVec3::new(4.0, 0.0, -4.0),
     ]];
-    let eye = DVec3::new(
-        rng.gen_range(-3.0..3.0),
-        rng.gen_range(1.5..4.0),
-        rng.gen_range(3.0..5.0),
-    );
+    let eye = DVec3::new(rng.gen_range(-3.0..3.0), rng.gen_range(1.5..4.0), rng.gen_range(3.0..5.0));
     for k in 0..opts.polygons {
         let near_eye = k == 0 && rng.gen_bool(0.5);
         let center = if near_eye {
             // Straddles the camera's near plane: the eye sits almost on it.
             eye + DVec3::new(rng.gen_range(-0.3..0.3), rng.gen_range(-0.3..0.3), -0.2)
         } else {
-            DVec3::new(
-                rng.gen_range(-2.0..2.0),
-                rng.gen_range(0.2..2.0),
-                rng.gen_range(-2.0..2.0),
-            )
+            DVec3::new(rng.gen_range(-2.0..2.0), rng.gen_range(0.2..2.0), rng.gen_range(-2.0..2.0))
         };
-        let n = DVec3::new(
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-        )
-        .normalize_or(DVec3::Y);
+        let n = DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0))
+            .normalize_or(DVec3::Y);
         let a = n.any_orthonormal_vector();
         let b = n.cross(a);
         let star = rng.gen_bool(0.4);
-        let sides = if star {
-            2 * rng.gen_range(3..6)
-        } else {
-            rng.gen_range(3..7)
-        };
+        let sides = if star { 2 * rng.gen_range(3..6) } else { rng.gen_range(3..7) };
         let r = rng.gen_range(0.4..1.4);
         let phase = rng.gen_range(0.0..PI);
         polys.push(
@@ -348,23 +255,13 @@ pub fn random(seed: u64, opts: RandomOptions) -> Result<Scene> {
     let mut lights = Vec::new();
     for _ in 0..rng.gen_range(1..=3) {
         let kind = loop {
-            let pos = DVec3::new(
-                rng.gen_range(-3.0..3.0),
-                rng.gen_range(2.5..5.0),
-                rng.gen_range(-3.0..3.0),
-            );
+            let pos = DVec3::new(rng.gen_range(-3.0..3.0), rng.gen_range(2.5..5.0), rng.gen_range(-3.0..3.0));
             let kind = match rng.gen_range(0..4) {
                 0 => LightKind::Point { position: pos },
                 1 => LightKind::Directional {
-                    direction: DVec3::new(rng.gen_range(-0.5..0.5), -1.0, rng.gen_range(-0.5..0.5))
-                        .normalize(),
+                    direction: DVec3::new(rng.gen_range(-0.5..0.5), -1.0, rng.gen_range(-0.5..0.5)).normalize(),
                 },
-                2 => LightKind::Spot {
-                    position: pos,
-                    direction: (-pos).normalize(),
-                    cutoff: 60.0,
-                    exponent: 1.0,
-                },
+                2 => LightKind::Spot { position: pos, direction: (-pos).normalize(), cutoff: 60.0, exponent: 1.0 },
                 _ => LightKind::Area {
                     corner: pos,
                     edge_u: DVec3::new(rng.gen_range(0.2..0.8), 0.0, 0.0),
@@ -372,33 +269,20 @@ pub fn random(seed: u64, opts: RandomOptions) -> Result<Scene> {
                     samples: [2, 2],
                 },
             };
-            let ok = Light {
-                kind: kind.clone(),
-                color: Vec3::ONE,
-                intensity: 1.0,
-                attenuation: [1.0, 0.0, 0.0],
-            }
-            .samples()
-            .iter()
-            .all(|s| match s {
-                crate::scene::LightSample::Point(p) => clear(*p),
-                crate::scene::LightSample::Directional(_) => true,
-            });
+            let ok = Light { kind: kind.clone(), color: Vec3::ONE, intensity: 1.0, attenuation: [1.0, 0.0, 0.0] }
+                .samples()
+                .iter()
+                .all(|s| match s {
+                    crate::scene::LightSample::Point(p) => clear(*p),
+                    crate::scene::LightSample::Directional(_) => true,
+                });
             if ok {
                 break kind;
             }
         };
-        lights.push(Light {
-            kind,
-            color: Vec3::ONE,
-            intensity: 0.8,
-            attenuation: [1.0, 0.0, 0.0],
-        });
+        lights.push(Light { kind, color: Vec3::ONE, intensity: 0.8, attenuation: [1.0, 0.0, 0.0] });
     }
-    let cam = Camera {
-        near: 0.05,
-        ..camera(eye, DVec3::new(0.0, 0.5, 0.0), opts.width, opts.height)
-    };
+    let cam = Camera { near: 0.05, ..camera(eye, DVec3::new(0.0, 0.5, 0.0), opts.width, opts.height) };
     Scene::new(
         cam,
         RenderSettings::default(),

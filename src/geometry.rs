@@ -15,10 +15,7 @@ pub struct Plane {
 impl Plane {
     /// The plane through `point` with unit normal `n`.
     pub fn new(n: DVec3, point: DVec3) -> Self {
-        Plane {
-            n,
-            d: -n.dot(point),
-        }
+        Plane { n, d: -n.dot(point) }
     }
 
     /// Signed distance of `p` from the plane (positive on the front side).
@@ -81,11 +78,7 @@ pub fn classify_face(verts: &[DVec3]) -> FaceShape {
     }
     let v: Vec<DVec3> = idx.iter().map(|&i| verts[i]).collect();
     let mut distinct = v.clone();
-    distinct.sort_by(|a, b| {
-        a.to_array()
-            .partial_cmp(&b.to_array())
-            .unwrap_or(std::cmp::Ordering::Equal)
-    });
+    distinct.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).unwrap_or(std::cmp::Ordering::Equal));
     distinct.dedup();
     if distinct.len() < 3 {
         return FaceShape::Degenerate;
@@ -233,12 +226,7 @@ mod tests {
 
     #[test]
     fn even_odd_inside() {
-        let ring = [
-            DVec2::ZERO,
-            DVec2::new(4.0, 0.0),
-            DVec2::new(4.0, 4.0),
-            DVec2::new(0.0, 4.0),
-        ];
+        let ring = [DVec2::ZERO, DVec2::new(4.0, 0.0), DVec2::new(4.0, 4.0), DVec2::new(0.0, 4.0)];
         assert!(inside_even_odd(&ring, DVec2::new(2.0, 2.0)));
         assert!(!inside_even_odd(&ring, DVec2::new(5.0, 2.0)));
         assert!(inside_even_odd(&ring, DVec2::new(0.0, 0.0)));

@@ -101,22 +101,14 @@ fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
             let scene = Scene::load(&a.scene)?;
-            let opts = RenderOptions {
-                visibility: a.visibility,
-                shadows: a.shadows,
-                progress: true,
-            };
+            let opts = RenderOptions { visibility: a.visibility, shadows: a.shadows, progress: true };
             let out = render(&scene, &opts)?;
             out.frame.save_png(&a.output, a.gamma)?;
             if let Some(dir) = &a.aov {
                 out.frame.save_aovs(dir)?;
             }
             if a.stats {
-                println!(
-                    "{}",
-                    serde_json::to_string(&out.stats)
-                        .map_err(|e| umbra::Error::Invalid(e.to_string()))?
-                );
+                println!("{}", serde_json::to_string(&out.stats).map_err(|e| umbra::Error::Invalid(e.to_string()))?);
             }
             Ok(())
         }

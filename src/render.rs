@@ -33,11 +33,7 @@ pub struct RenderOptions {
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions {
-            visibility: VisibilityMethod::Scanline,
-            shadows: ShadowMethod::DEFAULT,
-            progress: false,
-        }
+        RenderOptions { visibility: VisibilityMethod::Scanline, shadows: ShadowMethod::DEFAULT, progress: false }
     }
 }
 
@@ -87,15 +83,11 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
 
     let t = Instant::now();
     let screen = view.screen_polygons(scene);
-    stats
-        .visibility_counters
-        .add("screen_polygons", screen.len() as u64);
+    stats.visibility_counters.add("screen_polygons", screen.len() as u64);
     stats.time_ms.insert("view", ms(t.elapsed()));
 
     let t = Instant::now();
-    let visibility = opts
-        .visibility
-        .prepare(scene, &view, &screen, &mut stats.visibility_counters);
+    let visibility = opts.visibility.prepare(scene, &view, &screen, &mut stats.visibility_counters);
     stats.time_ms.insert("visibility_prepare", ms(t.elapsed()));
 
     let t = Instant::now();
@@ -205,9 +197,7 @@ impl Progress {
         self.done += n;
         if self.bar.is_none() && self.enabled && self.start.elapsed() > Duration::from_secs(1) {
             let bar = ProgressBar::with_draw_target(Some(self.total), ProgressDrawTarget::stderr());
-            if let Ok(style) =
-                ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} lines {elapsed}")
-            {
+            if let Ok(style) = ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} lines {elapsed}") {
                 bar.set_style(style);
             }
             bar.set_message("rendering");

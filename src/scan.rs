@@ -44,16 +44,22 @@ pub struct Crossing {
     pub tag: u32,
 }
 
-/// The first pixel whose centre lies at or right of `x`, clamped to `0..=width`.
+/// The first pixel whose centre lies at or right of `x`, clamped to `0..=width`:
+/// `ceil(x - 0.5)`, written with a truncation so it needs no libm call.
 #[inline]
 pub fn boundary(x: f64, width: u32) -> u32 {
-    let b = (x - 0.5).ceil();
-    if b <= 0.0 {
-        0
-    } else if b >= width as f64 {
-        width
+    let v = x - 0.5;
+    if v.is_nan() || v <= 0.0 {
+        return 0;
+    }
+    if v >= width as f64 {
+        return width;
+    }
+    let t = v as u32;
+    if (t as f64) < v {
+        t + 1
     } else {
-        b as u32
+        t
     }
 }
 
@@ -71,10 +77,7 @@ pub struct EdgeTable {
 impl EdgeTable {
     /// An empty table for an image `height` lines high.
     pub fn new(height: u32) -> Self {
-        EdgeTable {
-            height,
-            ..Default::default()
-        }
+        EdgeTable { height, ..Default::default() }
     }
 
     /// Empties the table, keeping its memory, for an image `height` lines high.
@@ -110,14 +113,7 @@ impl EdgeTable {
             return;
         }
         let dxdy = (bot.x - top.x) / (bot.y - top.y);
-        self.edges.push(Edge {
-            x_top: top.x,
-            y_top: top.y,
-            dxdy,
-            first,
-            end,
-            tag,
-        });
+        self.edges.push(Edge { x_top: top.x, y_top: top.y, dxdy, first, end, tag });
     }
 
     /// Sorts the edges into buckets by first line (a counting sort). Call it after the last
@@ -159,6 +155,11 @@ impl EdgeTable {
         self.lines.clone()
     }
 
+    /// Bytes held by the table.
+    pub fn bytes(&self) -> usize {
+        self.edges.capacity() * std::mem::size_of::<Edge>() + self.bucket.capacity() * 4
+    }
+
     /// Number of edges.
     pub fn len(&self) -> usize {
         self.edges.len()
@@ -181,13 +182,15 @@ impl EdgeTable {
 /// The active edge table: walks an [`EdgeTable`] down a range of lines, giving each line's
 /// crossings sorted by x. Edges enter from their bucket and leave after their last line; the
 /// list stays sorted by an insertion sort, which costs little because order changes only
-/// where edges cross.
+/// where edges cross, and entering edges are sorted apart and merged in.
 #[derive(Debug)]
 pub struct ActiveEdges<'a> {
     table: &'a EdgeTable,
     next: u32,
     end: u32,
     active: Vec<(Crossing, u32)>,
+    incoming: Vec<(Crossing, u32)>,
+    merged: Vec<(Crossing, u32)>,
     out: Vec<Crossing>,
     /// Edges that entered so far (a counter for the stats).
     pub entered: u64,
@@ -197,10 +200,7 @@ impl<'a> ActiveEdges<'a> {
     /// Walks a finished `table` over `lines` (clamped to the lines the table covers). A range
     /// that starts below the table's first line picks up the edges already active there.
     pub fn new(table: &'a EdgeTable, lines: Range<u32>) -> ActiveEdges<'a> {
-        debug_assert!(
-            table.built,
-            "EdgeTable::finish must be called before walking"
-        );
+        debug_assert!(table.built, "EdgeTable::finish must be called before walking");
         let start = lines.start.max(table.lines.start);
         let end = lines.end.min(table.lines.end);
         let mut active = Vec::new();
@@ -208,15 +208,18 @@ impl<'a> ActiveEdges<'a> {
             let upto = table.bucket[(start - table.lines.start) as usize] as usize;
             for (i, e) in table.edges[..upto].iter().enumerate() {
                 if e.end > start {
-                    active.push((Crossing { x: 0.0, tag: e.tag }, i as u32));
+                    active.push((Crossing { x: e.x_at(start), tag: e.tag }, i as u32));
                 }
             }
+            active.sort_unstable_by(|a, b| a.0.x.total_cmp(&b.0.x));
         }
         ActiveEdges {
             table,
             next: start,
             end,
             active,
+            incoming: Vec::new(),
+            merged: Vec::new(),
             out: Vec::new(),
             entered: 0,
         }
@@ -230,22 +233,13 @@ impl<'a> ActiveEdges<'a> {
         let line = self.next;
         self.next += 1;
         let edges = &self.table.edges;
+        // Edges whose last line has passed leave; the others step to this line.
         self.active.retain(|&(_, i)| edges[i as usize].end > line);
-        let base = self
-            .table
-            .bucket
-            .get((line - self.table.lines.start) as usize)
-            .copied()
-            .unwrap_or(0);
-        for (k, e) in self.table.starting_on(line).iter().enumerate() {
-            self.active
-                .push((Crossing { x: 0.0, tag: e.tag }, base + k as u32));
-            self.entered += 1;
-        }
         for (c, i) in &mut self.active {
             c.x = edges[*i as usize].x_at(line);
         }
-        // Insertion sort: nearly sorted from the previous line.
+        // Insertion sort: the list was sorted on the previous line, and only edges that
+        // cross each other between two lines are out of order now.
         for i in 1..self.active.len() {
             let item = self.active[i];
             let mut j = i;
@@ -255,9 +249,44 @@ impl<'a> ActiveEdges<'a> {
             }
             self.active[j] = item;
         }
+        // Edges that start on this line are sorted among themselves, then merged in.
+        let base = self.table.bucket.get((line - self.table.lines.start) as usize).copied().unwrap_or(0);
+        let entering = self.table.starting_on(line);
+        if !entering.is_empty() {
+            self.entered += entering.len() as u64;
+            self.incoming.clear();
+            self.incoming.extend(
+                entering.iter().enumerate().map(|(k, e)| (Crossing { x: e.x_at(line), tag: e.tag }, base + k as u32)),
+            );
+            self.incoming.sort_unstable_by(|a, b| a.0.x.total_cmp(&b.0.x));
+            self.merged.clear();
+            let (mut a, mut b) = (self.active.iter().peekable(), self.incoming.iter().peekable());
+            loop {
+                let next = match (a.peek(), b.peek()) {
+                    (Some(x), Some(y)) => {
+                        if y.0.x < x.0.x {
+                            b.next()
+                        } else {
+                            a.next()
+                        }
+                    }
+                    (Some(_), None) => a.next(),
+                    (None, Some(_)) => b.next(),
+                    (None, None) => break,
+                };
+                self.merged.extend(next.copied());
+            }
+            std::mem::swap(&mut self.active, &mut self.merged);
+        }
         self.out.clear();
         self.out.extend(self.active.iter().map(|&(c, _)| c));
         Some((line, &self.out))
+    }
+
+    /// Bytes held by the walker.
+    pub fn bytes(&self) -> usize {
+        self.active.capacity() * std::mem::size_of::<(Crossing, u32)>()
+            + self.out.capacity() * std::mem::size_of::<Crossing>()
     }
 
     /// Number of edges active on the current line.
@@ -305,29 +334,25 @@ mod tests {
     }
 
     #[test]
+    fn boundary_is_ceil_of_x_minus_half() {
+        for &x in &[-3.0, 0.0, 0.5, 0.50000001, 1.0, 1.5, 2.49, 7.5, 9.9, 1e9] {
+            let want = (x - 0.5f64).ceil().clamp(0.0, 10.0) as u32;
+            assert_eq!(boundary(x, 10), want, "x = {x}");
+        }
+        assert_eq!(boundary(f64::NAN, 10), 0);
+    }
+
+    #[test]
     fn square_covers_the_pixel_centres_inside() {
-        let sq = [
-            DVec2::new(1.0, 1.0),
-            DVec2::new(4.0, 1.0),
-            DVec2::new(4.0, 3.0),
-            DVec2::new(1.0, 3.0),
-        ];
+        let sq = [DVec2::new(1.0, 1.0), DVec2::new(4.0, 1.0), DVec2::new(4.0, 3.0), DVec2::new(1.0, 3.0)];
         assert_eq!(spans(&sq, 8, 8), vec![(1, 1, 4), (2, 1, 4)]);
     }
 
     #[test]
     fn shared_edges_cover_each_centre_once() {
         // Two triangles sharing a diagonal tile a square: every centre covered exactly once.
-        let a = [
-            DVec2::new(0.0, 0.0),
-            DVec2::new(7.3, 0.0),
-            DVec2::new(0.0, 5.9),
-        ];
-        let b = [
-            DVec2::new(7.3, 0.0),
-            DVec2::new(7.3, 5.9),
-            DVec2::new(0.0, 5.9),
-        ];
+        let a = [DVec2::new(0.0, 0.0), DVec2::new(7.3, 0.0), DVec2::new(0.0, 5.9)];
+        let b = [DVec2::new(7.3, 0.0), DVec2::new(7.3, 5.9), DVec2::new(0.0, 5.9)];
         let mut count = [[0; 8]; 6];
         for (y, x0, x1) in spans(&a, 8, 6).into_iter().chain(spans(&b, 8, 6)) {
             for x in x0..x1 {
@@ -341,11 +366,7 @@ mod tests {
 
     #[test]
     fn band_start_picks_up_active_edges() {
-        let tri = [
-            DVec2::new(0.0, 0.0),
-            DVec2::new(10.0, 10.0),
-            DVec2::new(0.0, 10.0),
-        ];
+        let tri = [DVec2::new(0.0, 0.0), DVec2::new(10.0, 10.0), DVec2::new(0.0, 10.0)];
         let mut t = EdgeTable::new(10);
         t.add_ring(0, &tri);
         t.finish();
@@ -365,11 +386,7 @@ mod tests {
     #[test]
     fn long_thin_edges_do_not_drift() {
         // A sliver 1e5 pixels long: each line's crossing equals the exact interpolation.
-        let ring = [
-            DVec2::new(0.0, 0.0),
-            DVec2::new(1e5, 1000.0),
-            DVec2::new(0.0, 0.3),
-        ];
+        let ring = [DVec2::new(0.0, 0.0), DVec2::new(1e5, 1000.0), DVec2::new(0.0, 0.3)];
         let mut t = EdgeTable::new(1000);
         t.add_ring(0, &ring);
         t.finish();

@@ -21,11 +21,7 @@ pub struct Shader<'a> {
 impl<'a> Shader<'a> {
     /// A shader for `scene` from `view`, with each light's samples.
     pub fn new(scene: &'a Scene, view: &'a View, samples: &'a [Vec<LightSample>]) -> Self {
-        Shader {
-            scene,
-            view,
-            samples,
-        }
+        Shader { scene, view, samples }
     }
 
     /// The ambient term `Ia ka Od` of polygon `poly`.
@@ -46,14 +42,7 @@ impl<'a> Shader<'a> {
 
     /// Adds the light of sample `sample` of light `light` to `out`, pixel `i` weighted by
     /// `lit[i]`, for a run on polygon `poly`.
-    pub fn add_light(
-        &self,
-        poly: usize,
-        light: usize,
-        sample: usize,
-        lit: &[f32],
-        out: &mut [Vec3],
-    ) {
+    pub fn add_light(&self, poly: usize, light: usize, sample: usize, lit: &[f32], out: &mut [Vec3]) {
         let l = &self.scene.lights[light];
         let m = self.scene.material(poly);
         let n = self.seen_normal(poly);

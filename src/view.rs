@@ -128,10 +128,7 @@ impl View {
         }
         // 1/z = -(n.f + sx n.r + sy n.u) / e, with sx, sy affine in x, y.
         let k = -1.0 / e;
-        let (nr, nu) = (
-            plane.n.dot(self.r) * self.t * self.aspect,
-            plane.n.dot(self.u) * self.t,
-        );
+        let (nr, nu) = (plane.n.dot(self.r) * self.t * self.aspect, plane.n.dot(self.u) * self.t);
         Some(DepthPlane {
             a: k * nr * 2.0 / self.width as f64,
             b: -k * nu * 2.0 / self.height as f64,
@@ -141,12 +138,7 @@ impl View {
 
     /// Clips a world polygon to `near <= z (<= far)` in camera space and projects it.
     /// Returns `false` (and leaves `out` empty) when nothing is left.
-    pub fn clip_project(
-        &self,
-        verts: &[DVec3],
-        scratch: &mut [Vec<DVec3>; 2],
-        out: &mut Vec<DVec2>,
-    ) -> bool {
+    pub fn clip_project(&self, verts: &[DVec3], scratch: &mut [Vec<DVec3>; 2], out: &mut Vec<DVec2>) -> bool {
         out.clear();
         let [a, b] = scratch;
         a.clear();
@@ -178,11 +170,7 @@ impl View {
                 continue;
             };
             if self.clip_project(scene.verts(i), &mut scratch, &mut ring) {
-                out.push(ScreenPolygon {
-                    poly: i as u32,
-                    ring: ring.clone(),
-                    depth,
-                });
+                out.push(ScreenPolygon { poly: i as u32, ring: ring.clone(), depth });
             }
         }
         out

@@ -22,20 +22,10 @@ fn render_writes_image_aovs_and_stats() {
         .arg(d.join("o.png"))
         .arg("--aov")
         .arg(d.join("aov"))
-        .args([
-            "--stats",
-            "--visibility",
-            "zbuffer",
-            "--shadows",
-            "ray-cast",
-        ])
+        .args(["--stats", "--visibility", "zbuffer", "--shadows", "ray-cast"])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(stats["visibility"], "zbuffer");
     assert!(stats["shadow_counters"]["shadow_rays"].as_u64().unwrap() > 0);
@@ -54,34 +44,18 @@ fn render_writes_image_aovs_and_stats() {
 fn bad_input_is_one_line_and_non_zero() {
     let d = tmp("bad");
     let bad = d.join("bad.toml");
-    std::fs::write(
-        &bad,
-        "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nzoom = 2\n",
-    )
-    .unwrap();
-    let out = umbra()
-        .arg("render")
-        .arg(&bad)
-        .arg("-o")
-        .arg(d.join("o.png"))
-        .output()
-        .unwrap();
+    std::fs::write(&bad, "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nzoom = 2\n").unwrap();
+    let out = umbra().arg("render").arg(&bad).arg("-o").arg(d.join("o.png")).output().unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("bad.toml:4:") && err.contains("zoom"), "{err}");
 
-    let out = umbra()
-        .args(["render", "/no/such/scene.toml"])
-        .output()
-        .unwrap();
+    let out = umbra().args(["render", "/no/such/scene.toml"]).output().unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such/scene.toml"));
 
-    let out = umbra()
-        .args(["render", "x.toml", "--shadows", "magic"])
-        .output()
-        .unwrap();
+    let out = umbra().args(["render", "x.toml", "--shadows", "magic"]).output().unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("known: none"));
 }
@@ -90,22 +64,13 @@ fn bad_input_is_one_line_and_non_zero() {
 fn generate_writes_a_loadable_scene() {
     let d = tmp("gen");
     let out = umbra()
-        .args([
-            "generate", "cubes", "--n", "2", "--width", "64", "--height", "48", "-o",
-        ])
+        .args(["generate", "cubes", "--n", "2", "--width", "64", "--height", "48", "-o"])
         .arg(d.join("c.toml"))
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let s = umbra::Scene::load(d.join("c.toml")).unwrap();
     assert_eq!(s.polygons.len(), 1 + 2 * 2 * 12);
     let direct = umbra::generate::cubes(2, true, 64, 48).unwrap();
-    assert_eq!(
-        s.vertices, direct.vertices,
-        "written and generated scenes are the same"
-    );
+    assert_eq!(s.vertices, direct.vertices, "written and generated scenes are the same");
 }

@@ -5,12 +5,7 @@ use std::path::Path;
 use umbra::Scene;
 
 fn load(src: &str) -> Result<Scene, String> {
-    Scene::from_toml(
-        src,
-        Path::new("s.toml"),
-        Path::new(env!("CARGO_MANIFEST_DIR")),
-    )
-    .map_err(|e| e.to_string())
+    Scene::from_toml(src, Path::new("s.toml"), Path::new(env!("CARGO_MANIFEST_DIR"))).map_err(|e| e.to_string())
 }
 
 const CAMERA: &str = "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n";
@@ -33,15 +28,9 @@ fn bad_number_and_nan() {
     let e = err("[[light]]\nkind = \"point\"\nposition = [1.0, \"x\", 2.0]\n");
     assert!(e.starts_with("s.toml:6:"), "{e}");
     let e = err("[[light]]\nkind = \"point\"\nposition = [1.0, nan, 2.0]\n");
-    assert!(
-        e.starts_with("s.toml:6:") && e.contains("not a finite number"),
-        "{e}"
-    );
+    assert!(e.starts_with("s.toml:6:") && e.contains("not a finite number"), "{e}");
     let e = err("[[object]]\npolygons = [[[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,inf,0.0]]]\n");
-    assert!(
-        e.starts_with("s.toml:5:") && e.contains("not a finite number"),
-        "{e}"
-    );
+    assert!(e.starts_with("s.toml:5:") && e.contains("not a finite number"), "{e}");
 }
 
 #[test]
@@ -68,13 +57,8 @@ fn bad_obj_line_names_the_obj_file() {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").unwrap();
     let src = format!("{CAMERA}[[object]]\nmesh = \"m.obj\"\n");
-    let e = Scene::from_toml(&src, &dir.join("s.toml"), &dir)
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.ends_with("m.obj:4: vertex index 4 out of range (3 defined so far)"),
-        "{e}"
-    );
+    let e = Scene::from_toml(&src, &dir.join("s.toml"), &dir).unwrap_err().to_string();
+    assert!(e.ends_with("m.obj:4: vertex index 4 out of range (3 defined so far)"), "{e}");
 }
 
 #[test]
@@ -84,24 +68,15 @@ fn light_keys_checked_per_kind() {
         "s.toml:4:1: spot light needs 'direction'"
     );
     let e = err("[[light]]\nkind = \"point\"\nposition = [0.0, 1.0, 0.0]\ncutoff = 10.0\n");
-    assert!(
-        e.contains("'cutoff/exponent' applies to spot lights only"),
-        "{e}"
-    );
+    assert!(e.contains("'cutoff/exponent' applies to spot lights only"), "{e}");
     let e = err("[[light]]\nkind = \"laser\"\n");
-    assert!(
-        e.starts_with("s.toml:5:") && e.contains("unknown variant `laser`"),
-        "{e}"
-    );
+    assert!(e.starts_with("s.toml:5:") && e.contains("unknown variant `laser`"), "{e}");
 }
 
 #[test]
 fn camera_checks() {
     let e = load("[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 5.0]\n").unwrap_err();
-    assert!(
-        e.starts_with("s.toml:1:") && e.contains("same point"),
-        "{e}"
-    );
+    assert!(e.starts_with("s.toml:1:") && e.contains("same point"), "{e}");
     let e = load("[camera]\neye = [0.0, 5.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\n").unwrap_err();
     assert!(e.contains("up is parallel"), "{e}");
 }
@@ -116,11 +91,7 @@ fn face_ids_run_across_objects_and_fans_keep_theirs() {
     assert_eq!(s.face_count, 3);
     // Face 1 is degenerate (two vertices): it keeps its id and draws nothing.
     let faces: Vec<u32> = s.polygons.iter().map(|p| p.face).collect();
-    assert_eq!(
-        faces,
-        vec![0, 2, 2],
-        "the non-planar face 2 is a fan of two triangles"
-    );
+    assert_eq!(faces, vec![0, 2, 2], "the non-planar face 2 is a fan of two triangles");
 }
 
 #[test]
@@ -131,10 +102,7 @@ fn transforms_apply_scale_rotate_translate_in_order() {
     .unwrap();
     // (1,0,0) -> scale (2,0,0) -> rotate 90° about Z (0,2,0) -> translate (10,2,0).
     let v = s.verts(0)[0];
-    assert!(
-        (v - glam::DVec3::new(10.0, 2.0, 0.0)).length() < 1e-12,
-        "{v}"
-    );
+    assert!((v - glam::DVec3::new(10.0, 2.0, 0.0)).length() < 1e-12, "{v}");
 }
 
 #[test]
@@ -150,11 +118,7 @@ fn every_example_scene_loads() {
 
 #[test]
 fn cornell_obj_negative_indices_and_fan() {
-    let s =
-        Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-obj.toml")).unwrap();
+    let s = Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-obj.toml")).unwrap();
     assert_eq!(s.face_count, 18);
-    assert!(
-        s.polygons.len() > 18,
-        "the non-planar wall is split into a fan"
-    );
+    assert!(s.polygons.len() > 18, "the non-planar wall is split into a fan");
 }

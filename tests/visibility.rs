@@ -15,11 +15,7 @@ fn example_scenes_agree_with_ray_cast() {
         for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
             let got = frame(&scene, v, ShadowMethod::None);
             let n = assert_ids_agree(&reference, &got, &format!("{} {v}", path.display()));
-            assert!(
-                n > 1000,
-                "{}: too few interior pixels ({n})",
-                path.display()
-            );
+            assert!(n > 1000, "{}: too few interior pixels ({n})", path.display());
         }
     }
 }
@@ -30,52 +26,23 @@ fn random_scenes_agree_with_ray_cast() {
     let mut splits = 0;
     let mut clipped = 0;
     for seed in 0..300 {
-        let scene = random(
-            seed,
-            RandomOptions {
-                width: 64,
-                height: 48,
-                ..RandomOptions::default()
-            },
-        )
-        .unwrap();
-        let opts = umbra::RenderOptions {
-            shadows: ShadowMethod::None,
-            ..Default::default()
-        };
-        splits += umbra::render(&scene, &opts)
-            .unwrap()
-            .stats
-            .visibility_counters
-            .get("span_splits");
+        let scene = random(seed, RandomOptions { width: 64, height: 48, ..RandomOptions::default() }).unwrap();
+        let opts = umbra::RenderOptions { shadows: ShadowMethod::None, ..Default::default() };
+        splits += umbra::render(&scene, &opts).unwrap().stats.visibility_counters.get("span_splits");
         let view = umbra::view::View::new(&scene.camera);
         clipped += (0..scene.polygons.len())
-            .filter(|&i| {
-                scene
-                    .verts(i)
-                    .iter()
-                    .any(|&p| view.to_camera(p).z < scene.camera.near)
-            })
+            .filter(|&i| scene.verts(i).iter().any(|&p| view.to_camera(p).z < scene.camera.near))
             .count();
         let reference = frame(&scene, VisibilityMethod::RayCast, ShadowMethod::None);
         for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
-            compared += assert_ids_agree(
-                &reference,
-                &frame(&scene, v, ShadowMethod::None),
-                &format!("seed {seed} {v}"),
-            );
+            compared +=
+                assert_ids_agree(&reference, &frame(&scene, v, ShadowMethod::None), &format!("seed {seed} {v}"));
         }
     }
     assert!(compared > 300 * 2 * 500);
     // The random family does exercise interpenetration and near-plane clipping.
-    assert!(
-        splits > 100,
-        "only {splits} Watkins span splits in 300 random scenes"
-    );
-    assert!(
-        clipped > 20,
-        "only {clipped} polygons cross the near plane in 300 random scenes"
-    );
+    assert!(splits > 100, "only {splits} Watkins span splits in 300 random scenes");
+    assert!(clipped > 20, "only {clipped} polygons cross the near plane in 300 random scenes");
 }
 
 #[test]
@@ -88,11 +55,7 @@ fn generated_benchmark_scenes_agree() {
     for (i, scene) in scenes.iter().enumerate() {
         let reference = frame(scene, VisibilityMethod::RayCast, ShadowMethod::None);
         for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
-            assert_ids_agree(
-                &reference,
-                &frame(scene, v, ShadowMethod::None),
-                &format!("generated {i} {v}"),
-            );
+            assert_ids_agree(&reference, &frame(scene, v, ShadowMethod::None), &format!("generated {i} {v}"));
         }
     }
 }

@@ -3,8 +3,7 @@
 //! error names the file and line.
 
 use super::{
-    Camera, Light, LightKind, Material, Mesh, Object, RenderSettings, Scene, ShadingMode,
-    SpecularModel, Transform,
+    Camera, Light, LightKind, Material, Mesh, Object, RenderSettings, Scene, ShadingMode, SpecularModel, Transform,
 };
 use crate::error::{Error, FileLoc, Result};
 use glam::{DVec3, Vec3};
@@ -64,16 +63,10 @@ impl<'de> Deserialize<'de> for Scale {
             fn visit_i64<E: de::Error>(self, x: i64) -> std::result::Result<Scale, E> {
                 Ok(Scale(DVec3::splat(x as f64)))
             }
-            fn visit_seq<A: SeqAccess<'de>>(
-                self,
-                mut seq: A,
-            ) -> std::result::Result<Scale, A::Error> {
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> std::result::Result<Scale, A::Error> {
                 let mut c = [0.0; 3];
                 for (i, x) in c.iter_mut().enumerate() {
-                    *x = seq
-                        .next_element::<Num>()?
-                        .ok_or_else(|| de::Error::invalid_length(i, &self))?
-                        .0;
+                    *x = seq.next_element::<Num>()?.ok_or_else(|| de::Error::invalid_length(i, &self))?.0;
                 }
                 if seq.next_element::<Num>()?.is_some() {
                     return Err(de::Error::invalid_length(4, &self));
@@ -188,10 +181,7 @@ impl Scene {
     /// Loads a scene file; meshes are read relative to its folder.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
         let path = path.as_ref();
-        let src = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: path.to_owned(),
-            source: e,
-        })?;
+        let src = std::fs::read_to_string(path).map_err(|e| Error::Io { path: path.to_owned(), source: e })?;
         let dir = path.parent().map(Path::to_owned).unwrap_or_default();
         Scene::from_toml(&src, path, &dir)
     }
@@ -222,12 +212,10 @@ impl Scene {
         };
         camera.validate().map_err(|m| cx.err(cam_span, m))?;
 
-        let render = raw
-            .render
-            .map_or_else(RenderSettings::default, |r| RenderSettings {
-                ambient: r.ambient.map_or(Vec3::splat(0.1), c3),
-                background: r.background.map_or(Vec3::ZERO, c3),
-            });
+        let render = raw.render.map_or_else(RenderSettings::default, |r| RenderSettings {
+            ambient: r.ambient.map_or(Vec3::splat(0.1), c3),
+            background: r.background.map_or(Vec3::ZERO, c3),
+        });
 
         let mut materials = Vec::new();
         let mut by_name = HashMap::new();
@@ -257,11 +245,7 @@ impl Scene {
             materials.push(mat);
         }
 
-        let lights = raw
-            .light
-            .into_iter()
-            .map(|l| light(&cx, l))
-            .collect::<Result<Vec<_>>>()?;
+        let lights = raw.light.into_iter().map(|l| light(&cx, l)).collect::<Result<Vec<_>>>()?;
 
         let mut objects = Vec::new();
         let mut meshes: HashMap<PathBuf, Arc<Mesh>> = HashMap::new();
@@ -270,23 +254,15 @@ impl Scene {
             let o = o.into_inner();
             let material = match &o.material {
                 None => 0,
-                Some(name) => *by_name.get(name.get_ref()).ok_or_else(|| {
-                    cx.err(
-                        name.span(),
-                        format!("no material named '{}'", name.get_ref()),
-                    )
-                })?,
+                Some(name) => *by_name
+                    .get(name.get_ref())
+                    .ok_or_else(|| cx.err(name.span(), format!("no material named '{}'", name.get_ref())))?,
             };
             let mesh = match (o.mesh, o.polygons) {
-                (Some(_), Some(_)) => {
-                    return Err(cx.err(span, "object has both 'mesh' and 'polygons'"))
-                }
+                (Some(_), Some(_)) => return Err(cx.err(span, "object has both 'mesh' and 'polygons'")),
                 (None, None) => return Err(cx.err(span, "object needs 'mesh' or 'polygons'")),
                 (None, Some(polys)) => {
-                    let polys: Vec<Vec<DVec3>> = polys
-                        .into_iter()
-                        .map(|p| p.into_iter().map(v3).collect())
-                        .collect();
+                    let polys: Vec<Vec<DVec3>> = polys.into_iter().map(|p| p.into_iter().map(v3).collect()).collect();
                     if polys.iter().any(Vec::is_empty) {
                         return Err(cx.err(span, "a polygon in 'polygons' has no vertices"));
                     }
@@ -298,10 +274,7 @@ impl Scene {
                         Some(m) => m.clone(),
                         None => {
                             let text = std::fs::read_to_string(&path).map_err(|e| {
-                                cx.err(
-                                    rel.span(),
-                                    format!("cannot read mesh '{}': {e}", path.display()),
-                                )
+                                cx.err(rel.span(), format!("cannot read mesh '{}': {e}", path.display()))
                             })?;
                             let m = Arc::new(super::parse_obj(&text, &path)?);
                             meshes.insert(path, m.clone());
@@ -335,46 +308,21 @@ fn light(cx: &Ctx, l: Spanned<RawLight>) -> Result<Light> {
     let l = l.into_inner();
     let kind = l.kind;
     let need = |v: Option<V3>, key: &str| {
-        v.map(v3).ok_or_else(|| {
-            cx.err(
-                span.clone(),
-                format!("{kind:?} light needs '{key}'").to_lowercase(),
-            )
-        })
+        v.map(v3).ok_or_else(|| cx.err(span.clone(), format!("{kind:?} light needs '{key}'").to_lowercase()))
     };
     let refuse = |present: bool, key: &str, kinds: &str| {
         if present {
-            Err(cx.err(
-                span.clone(),
-                format!("'{key}' applies to {kinds} lights only"),
-            ))
+            Err(cx.err(span.clone(), format!("'{key}' applies to {kinds} lights only")))
         } else {
             Ok(())
         }
     };
     use RawLightKind::*;
-    refuse(
-        l.position.is_some() && !matches!(kind, Point | Spot),
-        "position",
-        "point and spot",
-    )?;
-    refuse(
-        l.direction.is_some() && !matches!(kind, Directional | Spot),
-        "direction",
-        "directional and spot",
-    )?;
-    refuse(
-        (l.cutoff.is_some() || l.exponent.is_some()) && kind != Spot,
-        "cutoff/exponent",
-        "spot",
-    )?;
-    let area_keys =
-        l.corner.is_some() || l.edge_u.is_some() || l.edge_v.is_some() || l.samples.is_some();
-    refuse(
-        area_keys && kind != Area,
-        "corner/edge_u/edge_v/samples",
-        "area",
-    )?;
+    refuse(l.position.is_some() && !matches!(kind, Point | Spot), "position", "point and spot")?;
+    refuse(l.direction.is_some() && !matches!(kind, Directional | Spot), "direction", "directional and spot")?;
+    refuse((l.cutoff.is_some() || l.exponent.is_some()) && kind != Spot, "cutoff/exponent", "spot")?;
+    let area_keys = l.corner.is_some() || l.edge_u.is_some() || l.edge_v.is_some() || l.samples.is_some();
+    refuse(area_keys && kind != Area, "corner/edge_u/edge_v/samples", "area")?;
     let unit = |d: DVec3| {
         if d.length() == 0.0 {
             Err(cx.err(span.clone(), "light direction is the zero vector"))
@@ -383,12 +331,8 @@ fn light(cx: &Ctx, l: Spanned<RawLight>) -> Result<Light> {
         }
     };
     let kind = match kind {
-        Point => LightKind::Point {
-            position: need(l.position, "position")?,
-        },
-        Directional => LightKind::Directional {
-            direction: unit(need(l.direction, "direction")?)?,
-        },
+        Point => LightKind::Point { position: need(l.position, "position")? },
+        Directional => LightKind::Directional { direction: unit(need(l.direction, "direction")?)? },
         Spot => LightKind::Spot {
             position: need(l.position, "position")?,
             direction: unit(need(l.direction, "direction")?)?,
@@ -399,9 +343,7 @@ fn light(cx: &Ctx, l: Spanned<RawLight>) -> Result<Light> {
             corner: need(l.corner, "corner")?,
             edge_u: need(l.edge_u, "edge_u")?,
             edge_v: need(l.edge_v, "edge_v")?,
-            samples: l
-                .samples
-                .ok_or_else(|| cx.err(span.clone(), "area light needs 'samples'"))?,
+            samples: l.samples.ok_or_else(|| cx.err(span.clone(), "area light needs 'samples'"))?,
         },
     };
     let light = Light {

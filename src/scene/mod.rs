@@ -37,16 +37,7 @@ pub struct Camera {
 impl Camera {
     /// A camera at `eye` looking at `target` with the contract's defaults.
     pub fn new(eye: DVec3, target: DVec3) -> Self {
-        Camera {
-            eye,
-            target,
-            up: DVec3::Y,
-            fov_y: 45.0,
-            width: 640,
-            height: 480,
-            near: 0.01,
-            far: None,
-        }
+        Camera { eye, target, up: DVec3::Y, fov_y: 45.0, width: 640, height: 480, near: 0.01, far: None }
     }
 
     fn validate(&self) -> std::result::Result<(), String> {
@@ -58,26 +49,17 @@ impl Camera {
             return Err("camera up is parallel to the view direction".into());
         }
         if !(self.fov_y > 0.0 && self.fov_y < 180.0) {
-            return Err(format!(
-                "camera fov_y must be in (0, 180) degrees, got {}",
-                self.fov_y
-            ));
+            return Err(format!("camera fov_y must be in (0, 180) degrees, got {}", self.fov_y));
         }
         if self.width == 0 || self.height == 0 || self.width > 32768 || self.height > 32768 {
-            return Err(format!(
-                "camera size {}x{} must be 1..=32768 each way",
-                self.width, self.height
-            ));
+            return Err(format!("camera size {}x{} must be 1..=32768 each way", self.width, self.height));
         }
         if self.near <= 0.0 {
             return Err(format!("camera near must be > 0, got {}", self.near));
         }
         if let Some(far) = self.far {
             if far <= self.near {
-                return Err(format!(
-                    "camera far ({far}) must be beyond near ({})",
-                    self.near
-                ));
+                return Err(format!("camera far ({far}) must be beyond near ({})", self.near));
             }
         }
         Ok(())
@@ -95,10 +77,7 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings {
-            ambient: Vec3::splat(0.1),
-            background: Vec3::ZERO,
-        }
+        RenderSettings { ambient: Vec3::splat(0.1), background: Vec3::ZERO }
     }
 }
 
@@ -264,12 +243,7 @@ impl Light {
                 vec![LightSample::Point(position)]
             }
             LightKind::Directional { direction } => vec![LightSample::Directional(direction)],
-            LightKind::Area {
-                corner,
-                edge_u,
-                edge_v,
-                samples: [m, n],
-            } => (0..m)
+            LightKind::Area { corner, edge_u, edge_v, samples: [m, n] } => (0..m)
                 .flat_map(|i| {
                     (0..n).map(move |j| {
                         let u = (i as f64 + 0.5) / m as f64;
@@ -284,16 +258,14 @@ impl Light {
     /// Number of samples.
     pub fn sample_count(&self) -> usize {
         match self.kind {
-            LightKind::Area {
-                samples: [m, n], ..
-            } => (m * n) as usize,
+            LightKind::Area { samples: [m, n], .. } => (m * n) as usize,
             _ => 1,
         }
     }
 
     fn validate(&self) -> std::result::Result<(), String> {
         let a = self.attenuation;
-        if a.iter().any(|&c| !(c >= 0.0)) || a.iter().all(|&c| c == 0.0) {
+        if a.iter().any(|&c| c.is_nan() || c < 0.0) || a.iter().all(|&c| c == 0.0) {
             return Err(format!("attenuation {a:?} must be >= 0 and not all zero"));
         }
         match &self.kind {
@@ -302,22 +274,12 @@ impl Light {
             {
                 Err("light direction must be a unit vector".into())
             }
-            LightKind::Spot { cutoff, .. } if !(*cutoff > 0.0 && *cutoff <= 180.0) => Err(format!(
-                "spot cutoff must be in (0, 180] degrees, got {cutoff}"
-            )),
-            LightKind::Area {
-                edge_u,
-                edge_v,
-                samples,
-                ..
-            } => {
-                if samples[0] == 0
-                    || samples[1] == 0
-                    || samples[0] as u64 * samples[1] as u64 > 4096
-                {
-                    Err(format!(
-                        "area light samples {samples:?} must each be >= 1, at most 4096 in all"
-                    ))
+            LightKind::Spot { cutoff, .. } if !(*cutoff > 0.0 && *cutoff <= 180.0) => {
+                Err(format!("spot cutoff must be in (0, 180] degrees, got {cutoff}"))
+            }
+            LightKind::Area { edge_u, edge_v, samples, .. } => {
+                if samples[0] == 0 || samples[1] == 0 || samples[0] as u64 * samples[1] as u64 > 4096 {
+                    Err(format!("area light samples {samples:?} must each be >= 1, at most 4096 in all"))
                 } else if edge_u.cross(*edge_v).length() == 0.0 {
                     Err("area light edges edge_u and edge_v are parallel or zero".into())
                 } else {
@@ -356,10 +318,7 @@ impl Mesh {
         for p in polys {
             let first = mesh.positions.len() as u32;
             mesh.positions.extend_from_slice(p);
-            mesh.faces.push(Face {
-                vertices: (first..first + p.len() as u32).collect(),
-                normals: Vec::new(),
-            });
+            mesh.faces.push(Face { vertices: (first..first + p.len() as u32).collect(), normals: Vec::new() });
         }
         mesh
     }
@@ -378,11 +337,7 @@ pub struct Transform {
 
 impl Default for Transform {
     fn default() -> Self {
-        Transform {
-            scale: DVec3::ONE,
-            rotate: DVec3::ZERO,
-            translate: DVec3::ZERO,
-        }
+        Transform { scale: DVec3::ONE, rotate: DVec3::ZERO, translate: DVec3::ZERO }
     }
 }
 
@@ -466,18 +421,14 @@ impl Scene {
     ) -> Result<Scene> {
         camera.validate().map_err(Error::Invalid)?;
         for (i, l) in lights.iter().enumerate() {
-            l.validate()
-                .map_err(|m| Error::Invalid(format!("light {i}: {m}")))?;
+            l.validate().map_err(|m| Error::Invalid(format!("light {i}: {m}")))?;
         }
         if materials.is_empty() {
             materials.push(Material::new("default"));
         }
         for (i, o) in objects.iter().enumerate() {
             if o.material >= materials.len() {
-                return Err(Error::Invalid(format!(
-                    "object {i}: material index {} out of range",
-                    o.material
-                )));
+                return Err(Error::Invalid(format!("object {i}: material index {} out of range", o.material)));
             }
             let m = &o.mesh;
             let bad = m.faces.iter().any(|f| {
@@ -486,14 +437,11 @@ impl Scene {
                     || (!f.normals.is_empty() && f.normals.len() != f.vertices.len())
             });
             if bad {
-                return Err(Error::Invalid(format!(
-                    "object {i}: face index out of range"
-                )));
+                return Err(Error::Invalid(format!("object {i}: face index out of range")));
             }
             let finite = m.positions.iter().chain(&m.normals).all(|p| p.is_finite());
             let t = &o.transform;
-            if !finite || !(t.scale.is_finite() && t.rotate.is_finite() && t.translate.is_finite())
-            {
+            if !(finite && t.scale.is_finite() && t.rotate.is_finite() && t.translate.is_finite()) {
                 return Err(Error::Invalid(format!("object {i}: non-finite coordinate")));
             }
         }
@@ -517,16 +465,8 @@ impl Scene {
             let m = obj.transform.matrix();
             let nm = DMat3::from_mat4(m).inverse().transpose();
             let mesh = &obj.mesh;
-            let world: Vec<DVec3> = mesh
-                .positions
-                .iter()
-                .map(|&p| m.transform_point3(p))
-                .collect();
-            let vn: Vec<DVec3> = mesh
-                .normals
-                .iter()
-                .map(|&n| (nm * n).normalize_or_zero())
-                .collect();
+            let world: Vec<DVec3> = mesh.positions.iter().map(|&p| m.transform_point3(p)).collect();
+            let vn: Vec<DVec3> = mesh.normals.iter().map(|&n| (nm * n).normalize_or_zero()).collect();
             // Averaged normals for faces without `vn`: area-weighted face normals per vertex.
             let mut avg = vec![DVec3::ZERO; world.len()];
             for f in mesh.faces.iter().filter(|f| f.normals.is_empty()) {
@@ -542,11 +482,7 @@ impl Scene {
                 pts.clear();
                 pts.extend(f.vertices.iter().map(|&v| world[v as usize]));
                 let normal = |k: usize, plane: &Plane| {
-                    let n = if f.normals.is_empty() {
-                        avg[f.vertices[k] as usize]
-                    } else {
-                        vn[f.normals[k] as usize]
-                    };
+                    let n = if f.normals.is_empty() { avg[f.vertices[k] as usize] } else { vn[f.normals[k] as usize] };
                     let n = n.normalize_or_zero();
                     if n == DVec3::ZERO {
                         plane.n
@@ -560,13 +496,7 @@ impl Scene {
                         self.vertices.push(pts[k]);
                         self.normals.push(normal(k, &plane));
                     }
-                    self.polygons.push(Polygon {
-                        face,
-                        object: oi as u32,
-                        start,
-                        len: idx.len() as u32,
-                        plane,
-                    });
+                    self.polygons.push(Polygon { face, object: oi as u32, start, len: idx.len() as u32, plane });
                 };
                 match classify_face(&pts) {
                     FaceShape::Degenerate => {}
@@ -611,10 +541,6 @@ impl Scene {
     /// The axis-aligned bounds of all polygons (`None` when there are none).
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
         let first = *self.vertices.first()?;
-        Some(
-            self.vertices
-                .iter()
-                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
-        )
+        Some(self.vertices.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
     }
 }

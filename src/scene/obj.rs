@@ -45,10 +45,7 @@ pub fn parse_obj(text: &str, file: &Path) -> Result<Mesh> {
                         return Err(Error::input(loc(), format!("bad face vertex '{w}'")));
                     }
                     let Some(v) = got[0] else {
-                        return Err(Error::input(
-                            loc(),
-                            format!("face vertex '{w}' has no vertex index"),
-                        ));
+                        return Err(Error::input(loc(), format!("face vertex '{w}' has no vertex index")));
                     };
                     face.vertices.push(v);
                     match got[2] {
@@ -71,28 +68,17 @@ pub fn parse_obj(text: &str, file: &Path) -> Result<Mesh> {
 }
 
 fn number(word: &str, what: &str, loc: &impl Fn() -> FileLoc) -> Result<f64> {
-    let x: f64 = word
-        .parse()
-        .map_err(|_| Error::input(loc(), format!("bad number '{word}' in '{what}'")))?;
+    let x: f64 = word.parse().map_err(|_| Error::input(loc(), format!("bad number '{word}' in '{what}'")))?;
     if !x.is_finite() {
-        return Err(Error::input(
-            loc(),
-            format!("non-finite number '{word}' in '{what}'"),
-        ));
+        return Err(Error::input(loc(), format!("non-finite number '{word}' in '{what}'")));
     }
     Ok(x)
 }
 
-fn vec3<'a>(
-    words: &mut impl Iterator<Item = &'a str>,
-    what: &str,
-    loc: &impl Fn() -> FileLoc,
-) -> Result<DVec3> {
+fn vec3<'a>(words: &mut impl Iterator<Item = &'a str>, what: &str, loc: &impl Fn() -> FileLoc) -> Result<DVec3> {
     let mut c = [0.0; 3];
     for x in &mut c {
-        let w = words
-            .next()
-            .ok_or_else(|| Error::input(loc(), format!("'{what}' needs three numbers")))?;
+        let w = words.next().ok_or_else(|| Error::input(loc(), format!("'{what}' needs three numbers")))?;
         *x = number(w, what, loc)?;
     }
     // An optional fourth (w) component is allowed for `v` and ignored.
@@ -104,15 +90,10 @@ fn vec3<'a>(
 
 /// Resolves a 1-based (or negative, relative) OBJ index against `count` items read so far.
 fn index(word: &str, count: usize, what: &str, loc: &impl Fn() -> FileLoc) -> Result<u32> {
-    let i: i64 = word
-        .parse()
-        .map_err(|_| Error::input(loc(), format!("bad {what} index '{word}'")))?;
+    let i: i64 = word.parse().map_err(|_| Error::input(loc(), format!("bad {what} index '{word}'")))?;
     let resolved = if i > 0 { i - 1 } else { count as i64 + i };
     if i == 0 || resolved < 0 || resolved >= count as i64 {
-        return Err(Error::input(
-            loc(),
-            format!("{what} index {i} out of range ({count} defined so far)"),
-        ));
+        return Err(Error::input(loc(), format!("{what} index {i} out of range ({count} defined so far)")));
     }
     Ok(resolved as u32)
 }
@@ -132,10 +113,7 @@ mod tests {
         assert_eq!(m.faces.len(), 3);
         assert_eq!(m.faces[1].vertices, vec![0, 1, 2]);
         assert_eq!(m.faces[1].normals, vec![0, 0, 0]);
-        assert!(
-            m.faces[2].normals.is_empty(),
-            "normals only when every vertex has one"
-        );
+        assert!(m.faces[2].normals.is_empty(), "normals only when every vertex has one");
     }
 
     #[test]

@@ -35,21 +35,12 @@ impl Scene {
             d3(c.target),
             d3(c.up)
         );
-        let _ = writeln!(
-            t,
-            "fov_y = {:?}\nwidth = {}\nheight = {}\nnear = {:?}",
-            c.fov_y, c.width, c.height, c.near
-        );
+        let _ = writeln!(t, "fov_y = {:?}\nwidth = {}\nheight = {}\nnear = {:?}", c.fov_y, c.width, c.height, c.near);
         if let Some(far) = c.far {
             let _ = writeln!(t, "far = {far:?}");
         }
         let r = &self.render;
-        let _ = writeln!(
-            t,
-            "\n[render]\nambient = {}\nbackground = {}",
-            f3(r.ambient),
-            f3(r.background)
-        );
+        let _ = writeln!(t, "\n[render]\nambient = {}\nbackground = {}", f3(r.ambient), f3(r.background));
         for m in &self.materials {
             let model = match m.model {
                 SpecularModel::Phong => "phong",
@@ -76,12 +67,7 @@ impl Scene {
                 LightKind::Directional { direction } => {
                     let _ = writeln!(t, "kind = \"directional\"\ndirection = {}", d3(direction));
                 }
-                LightKind::Spot {
-                    position,
-                    direction,
-                    cutoff,
-                    exponent,
-                } => {
+                LightKind::Spot { position, direction, cutoff, exponent } => {
                     let _ = writeln!(
                         t,
                         "kind = \"spot\"\nposition = {}\ndirection = {}\ncutoff = {cutoff:?}\nexponent = {exponent:?}",
@@ -89,12 +75,7 @@ impl Scene {
                         d3(direction)
                     );
                 }
-                LightKind::Area {
-                    corner,
-                    edge_u,
-                    edge_v,
-                    samples,
-                } => {
+                LightKind::Area { corner, edge_u, edge_v, samples } => {
                     let _ = writeln!(
                         t,
                         "kind = \"area\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nsamples = [{}, {}]",

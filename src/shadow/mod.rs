@@ -32,15 +32,8 @@ impl<'a> ShadowContext<'a> {
     /// The context for rendering `scene` from `view`.
     pub fn new(scene: &'a Scene, view: &'a View) -> Self {
         let samples = scene.lights.iter().map(|l| l.samples()).collect();
-        let extent = scene
-            .bounds()
-            .map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
-        ShadowContext {
-            scene,
-            view,
-            samples,
-            extent,
-        }
+        let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
+        ShadowContext { scene, view, samples, extent }
     }
 }
 
@@ -94,11 +87,7 @@ impl ShadowMethod {
     }
 
     /// Prepares the stage.
-    pub fn prepare<'a>(
-        self,
-        ctx: &'a ShadowContext<'a>,
-        counters: &mut Counters,
-    ) -> Result<Box<dyn ShadowStage + 'a>> {
+    pub fn prepare<'a>(self, ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Result<Box<dyn ShadowStage + 'a>> {
         Ok(match self {
             ShadowMethod::None => Box::new(NoShadows),
             ShadowMethod::RayCast => Box::new(RayCastShadows::new(ctx, counters)),
@@ -109,16 +98,10 @@ impl ShadowMethod {
 impl std::str::FromStr for ShadowMethod {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| {
-                let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
-                Error::Invalid(format!(
-                    "unknown shadow method '{s}' (known: {})",
-                    known.join(", ")
-                ))
-            })
+        Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
+            Error::Invalid(format!("unknown shadow method '{s}' (known: {})", known.join(", ")))
+        })
     }
 }
 

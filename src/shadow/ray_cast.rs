@@ -18,14 +18,9 @@ impl<'a> RayCastShadows<'a> {
     /// Builds the BVH of the shadow casters.
     pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
         let s = ctx.scene;
-        let casters: Vec<u32> = (0..s.polygons.len() as u32)
-            .filter(|&i| s.casts_shadows(i as usize))
-            .collect();
+        let casters: Vec<u32> = (0..s.polygons.len() as u32).filter(|&i| s.casts_shadows(i as usize)).collect();
         counters.add("casters", casters.len() as u64);
-        RayCastShadows {
-            ctx,
-            bvh: Bvh::new(s, casters),
-        }
+        RayCastShadows { ctx, bvh: Bvh::new(s, casters) }
     }
 }
 
@@ -36,10 +31,7 @@ struct Walker<'s> {
 
 impl ShadowStage for RayCastShadows<'_> {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
-        Box::new(Walker {
-            stage: self,
-            rays: 0,
-        })
+        Box::new(Walker { stage: self, rays: 0 })
     }
 }
 
@@ -51,23 +43,12 @@ impl ShadowWalker for Walker<'_> {
         // Open segment: ends within a relative 1e-9 of P or of the light do not count.
         let eps = 1e-9;
         for (i, out) in lit.iter_mut().enumerate() {
-            let p = ctx
-                .view
-                .point_on(&poly.plane, (run.x0 + i as u32) as f64 + 0.5, yc);
+            let p = ctx.view.point_on(&poly.plane, (run.x0 + i as u32) as f64 + 0.5, yc);
             let blocked = match ctx.samples[light][sample] {
-                LightSample::Point(s) => {
-                    self.stage
-                        .bvh
-                        .occluded(ctx.scene, p, s - p, eps, 1.0 - eps, poly.face)
+                LightSample::Point(s) => self.stage.bvh.occluded(ctx.scene, p, s - p, eps, 1.0 - eps, poly.face),
+                LightSample::Directional(d) => {
+                    self.stage.bvh.occluded(ctx.scene, p, -d, eps * ctx.extent, f64::INFINITY, poly.face)
                 }
-                LightSample::Directional(d) => self.stage.bvh.occluded(
-                    ctx.scene,
-                    p,
-                    -d,
-                    eps * ctx.extent,
-                    f64::INFINITY,
-                    poly.face,
-                ),
             };
             *out = if blocked { 0.0 } else { 1.0 };
         }

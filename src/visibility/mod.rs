@@ -47,11 +47,8 @@ pub enum VisibilityMethod {
 
 impl VisibilityMethod {
     /// Every method.
-    pub const ALL: [VisibilityMethod; 3] = [
-        VisibilityMethod::Scanline,
-        VisibilityMethod::ZBuffer,
-        VisibilityMethod::RayCast,
-    ];
+    pub const ALL: [VisibilityMethod; 3] =
+        [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer, VisibilityMethod::RayCast];
 
     /// The method's name on the command line.
     pub fn name(self) -> &'static str {
@@ -81,16 +78,10 @@ impl VisibilityMethod {
 impl std::str::FromStr for VisibilityMethod {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| {
-                let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
-                Error::Invalid(format!(
-                    "unknown visibility method '{s}' (known: {})",
-                    known.join(", ")
-                ))
-            })
+        Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
+            Error::Invalid(format!("unknown visibility method '{s}' (known: {})", known.join(", ")))
+        })
     }
 }
 
@@ -98,6 +89,33 @@ impl std::fmt::Display for VisibilityMethod {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
+}
+
+/// Runs the visibility stage alone over a whole frame: prepares it and walks every line in
+/// parallel bands, as [`crate::render()`] does, handing each band's runs to nobody. Returns
+/// the number of runs and the counters (for benchmarks and studies).
+pub fn resolve_frame(scene: &Scene, method: VisibilityMethod) -> (u64, Counters) {
+    use rayon::prelude::*;
+    let view = View::new(&scene.camera);
+    let screen = view.screen_polygons(scene);
+    let mut counters = Counters::default();
+    let vis = method.prepare(scene, &view, &screen, &mut counters);
+    let band = crate::render::band_height(view.height);
+    let parts: Vec<(u64, Counters)> = (0..view.height.div_ceil(band))
+        .into_par_iter()
+        .map(|b| {
+            let mut c = Counters::default();
+            let mut runs = 0u64;
+            vis.walk(b * band..((b + 1) * band).min(view.height), &mut c, &mut |_, r| runs += r.len() as u64);
+            (runs, c)
+        })
+        .collect();
+    let mut runs = 0;
+    for (r, c) in parts {
+        runs += r;
+        counters.merge(&c);
+    }
+    (runs, counters)
 }
 
 /// Appends `x0..x1` seeing `poly` to `runs`, merging it with the last run when they join.
@@ -123,11 +141,7 @@ pub(crate) fn runs_of_row(row: &[u32], runs: &mut Vec<Run>) {
             x += 1;
         }
         if p != u32::MAX {
-            runs.push(Run {
-                x0: start as u32,
-                x1: x as u32,
-                poly: p,
-            });
+            runs.push(Run { x0: start as u32, x1: x as u32, poly: p });
         }
     }
 }

@@ -27,9 +27,7 @@ impl<'a> RayCastVisibility<'a> {
         let d = self.view.ray(x as f64 + 0.5, y as f64 + 0.5);
         let far = self.view.far.unwrap_or(f64::INFINITY);
         // With d scaled to unit depth, the ray parameter is the camera-space depth.
-        self.bvh
-            .closest(self.scene, self.view.eye, d, self.view.near, far)
-            .map(|(i, _)| i)
+        self.bvh.closest(self.scene, self.view.eye, d, self.view.near, far).map(|(i, _)| i)
     }
 }
 

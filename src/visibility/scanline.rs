@@ -31,11 +31,8 @@ impl<'a> ScanlineVisibility<'a> {
         }
         table.finish();
         counters.add("edges", table.len() as u64);
-        ScanlineVisibility {
-            screen,
-            table,
-            width: view.width,
-        }
+        counters.add("table_bytes", table.bytes() as u64);
+        ScanlineVisibility { screen, table, width: view.width }
     }
 }
 
@@ -70,27 +67,16 @@ impl Walk<'_> {
     fn resolve(&mut self, set: &[u32], a: u32, b: u32, runs: &mut Vec<Run>) {
         self.spans += 1;
         let left = self.nearest(set, a);
-        let right = if b - a == 1 {
-            left
-        } else {
-            self.nearest(set, b - 1)
-        };
+        let right = if b - a == 1 { left } else { self.nearest(set, b - 1) };
         if left == right {
             push_run(runs, a, b, self.screen[left as usize].poly);
             return;
         }
         // The two winners' inverse depths are equal at x* (they interpenetrate there).
         self.splits += 1;
-        let (l, r) = (
-            &self.screen[left as usize].depth,
-            &self.screen[right as usize].depth,
-        );
+        let (l, r) = (&self.screen[left as usize].depth, &self.screen[right as usize].depth);
         let x_star = ((r.b - l.b) * self.yc + (r.c - l.c)) / (l.a - r.a);
-        let m = if x_star.is_finite() {
-            boundary(x_star, u32::MAX)
-        } else {
-            a + (b - a) / 2
-        };
+        let m = if x_star.is_finite() { boundary(x_star, u32::MAX) } else { a + (b - a) / 2 };
         let m = m.clamp(a + 1, b - 1);
         self.resolve(set, a, m, runs);
         self.resolve(set, m, b, runs);
@@ -103,13 +89,7 @@ impl Visibility for ScanlineVisibility<'_> {
         let mut inside = vec![false; self.screen.len()];
         let mut set: Vec<u32> = Vec::new();
         let mut runs = Vec::new();
-        let mut walk = Walk {
-            screen: self.screen,
-            yc: 0.0,
-            spans: 0,
-            splits: 0,
-            depth_tests: 0,
-        };
+        let mut walk = Walk { screen: self.screen, yc: 0.0, spans: 0, splits: 0, depth_tests: 0 };
         let mut max_active = 0;
         let mut next = lines.start;
         let emit_empty_until = |upto: u32, next: &mut u32, f: &mut dyn FnMut(u32, &[Run])| {
@@ -149,5 +129,9 @@ impl Visibility for ScanlineVisibility<'_> {
         counters.add("span_splits", walk.splits);
         counters.add("depth_tests", walk.depth_tests);
         counters.add("active_edges_max", max_active as u64);
+        // Working memory of this band: active edges, the inside flags, the span set, the runs.
+        let band_bytes =
+            aet.bytes() + inside.capacity() + set.capacity() * 4 + runs.capacity() * std::mem::size_of::<Run>();
+        counters.add("band_bytes_max", band_bytes as u64);
     }
 }

@@ -24,12 +24,8 @@ impl ZBufferVisibility {
         let spans: Vec<Range<u32>> = screen
             .iter()
             .map(|p| {
-                let (lo, hi) = p
-                    .ring
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
-                        (lo.min(q.y), hi.max(q.y))
-                    });
+                let (lo, hi) =
+                    p.ring.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(q.y), hi.max(q.y)));
                 let first = (lo - 0.5).ceil().clamp(0.0, h as f64) as u32;
                 let end = (hi - 0.5).ceil().clamp(0.0, h as f64) as u32;
                 first..end
@@ -51,27 +47,20 @@ impl ZBufferVisibility {
                     if r.end <= lines.start || r.start >= lines.end {
                         continue;
                     }
-                    for_each_span(
-                        &mut table,
-                        &[&p.ring],
-                        view.width,
-                        h,
-                        lines.clone(),
-                        |y, x0, x1| {
-                            let yc = y as f64 + 0.5;
-                            let row = (y - y0) as usize * w;
-                            tests += (x1 - x0) as u64;
-                            for x in x0..x1 {
-                                let z = p.depth.inv_z(x as f64 + 0.5, yc);
-                                let k = row + x as usize;
-                                if z > depth[k] {
-                                    depth[k] = z;
-                                    ids[k] = p.poly;
-                                    writes += 1;
-                                }
+                    for_each_span(&mut table, &[&p.ring], view.width, h, lines.clone(), |y, x0, x1| {
+                        let yc = y as f64 + 0.5;
+                        let row = (y - y0) as usize * w;
+                        tests += (x1 - x0) as u64;
+                        for x in x0..x1 {
+                            let z = p.depth.inv_z(x as f64 + 0.5, yc);
+                            let k = row + x as usize;
+                            if z > depth[k] {
+                                depth[k] = z;
+                                ids[k] = p.poly;
+                                writes += 1;
                             }
-                        },
-                    );
+                        }
+                    });
                 }
                 (tests, writes)
             })
@@ -79,10 +68,7 @@ impl ZBufferVisibility {
         counters.add("depth_tests", counts.iter().map(|c| c.0).sum());
         counters.add("depth_writes", counts.iter().map(|c| c.1).sum());
         counters.add("buffer_bytes", (ids.len() * 4 + depth.len() * 8) as u64);
-        ZBufferVisibility {
-            width: view.width,
-            ids,
-        }
+        ZBufferVisibility { width: view.width, ids }
     }
 }
 

@@ -29,11 +29,7 @@ pub fn load_scaled(path: &PathBuf, max_width: u32) -> Scene {
 }
 
 pub fn frame(scene: &Scene, visibility: VisibilityMethod, shadows: ShadowMethod) -> Frame {
-    let opts = RenderOptions {
-        visibility,
-        shadows,
-        progress: false,
-    };
+    let opts = RenderOptions { visibility, shadows, progress: false };
     render(scene, &opts).unwrap_or_else(|e| panic!("{e}")).frame
 }
 
