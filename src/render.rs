@@ -57,14 +57,12 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-/// One band's output rows.
-struct Band {
+/// One band's rows of the frame's buffers.
+struct Band<'f> {
     y0: u32,
-    color: Vec<Vec3>,
-    id: Vec<u32>,
-    light: Vec<Vec<f32>>,
-    vis: Counters,
-    shadow: Counters,
+    color: &'f mut [Vec3],
+    id: &'f mut [u32],
+    light: Vec<&'f mut [f32]>,
 }
 
 /// Renders `scene` with the chosen stages.
@@ -98,34 +96,41 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
 
     let t = Instant::now();
     let shader = Shader::new(scene, &view, &ctx.samples);
+    let mut frame = Frame::new(w, h, scene.lights.len(), scene.render.background);
     let band = band_height(h);
-    let nbands = h.div_ceil(band);
+    let chunk = (band * w) as usize;
+    // Each band gets its own rows of every buffer.
+    let mut light_rows: Vec<_> = frame.light.iter_mut().map(|l| l.chunks_mut(chunk)).collect();
+    let jobs: Vec<Band> = frame
+        .color
+        .chunks_mut(chunk)
+        .zip(frame.id.chunks_mut(chunk))
+        .enumerate()
+        .map(|(b, (color, id))| Band {
+            y0: b as u32 * band,
+            color,
+            id,
+            light: light_rows.iter_mut().flat_map(|rows| rows.next()).collect(),
+        })
+        .collect();
     let progress = Mutex::new(Progress::new(opts.progress, h as u64));
-    let bands: Vec<Band> = (0..nbands)
+    let counters: Vec<(Counters, Counters)> = jobs
         .into_par_iter()
-        .map(|b| {
-            let y0 = b * band;
-            let y1 = (y0 + band).min(h);
-            let n = ((y1 - y0) * w) as usize;
-            let mut out = Band {
-                y0,
-                color: vec![scene.render.background; n],
-                id: vec![crate::frame::BACKGROUND; n],
-                light: vec![vec![0.0; n]; scene.lights.len()],
-                vis: Counters::default(),
-                shadow: Counters::default(),
-            };
+        .map(|out| {
+            let Band { y0, color, id, mut light } = out;
+            let y1 = y0 + (id.len() / w as usize) as u32;
+            let (mut vis, mut shadow) = (Counters::default(), Counters::default());
             let mut walker = shadows.walker();
             let mut lit = vec![0.0f32; w as usize];
             let mut self_shadowed = 0u64;
-            visibility.walk(y0..y1, &mut out.vis, &mut |y, runs| {
+            visibility.walk(y0..y1, &mut vis, &mut |y, runs| {
                 walker.start_line(y);
                 let row = ((y - y0) * w) as usize;
                 for run in runs {
                     let (a, b) = (row + run.x0 as usize, row + run.x1 as usize);
                     let poly = &scene.polygons[run.poly as usize];
-                    out.id[a..b].fill(poly.face);
-                    out.color[a..b].fill(shader.ambient(run.poly as usize));
+                    id[a..b].fill(poly.face);
+                    color[a..b].fill(shader.ambient(run.poly as usize));
                     for (l, samples) in ctx.samples.iter().enumerate() {
                         let share = 1.0 / samples.len() as f32;
                         for (s, sample) in samples.iter().enumerate() {
@@ -136,37 +141,28 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
                                 lit.fill(0.0);
                                 self_shadowed += 1;
                             }
-                            for (f, &v) in out.light[l][a..b].iter_mut().zip(lit.iter()) {
+                            for (f, &v) in light[l][a..b].iter_mut().zip(lit.iter()) {
                                 *f += v * share;
                             }
-                            shader.add_light(run.poly as usize, l, s, lit, &mut out.color[a..b]);
+                            shader.add_light(run.poly as usize, l, s, lit, &mut color[a..b]);
                         }
                     }
                 }
             });
-            walker.finish(&mut out.shadow);
-            out.shadow.add("self_shadowed_runs", self_shadowed);
+            walker.finish(&mut shadow);
+            shadow.add("self_shadowed_runs", self_shadowed);
             if let Ok(mut p) = progress.lock() {
                 p.advance((y1 - y0) as u64);
             }
-            out
+            (vis, shadow)
         })
         .collect();
     if let Ok(p) = progress.lock() {
         p.finish();
     }
-
-    let mut frame = Frame::new(w, h, scene.lights.len(), scene.render.background);
-    for b in bands {
-        let at = (b.y0 * w) as usize;
-        let n = b.id.len();
-        frame.color[at..at + n].copy_from_slice(&b.color);
-        frame.id[at..at + n].copy_from_slice(&b.id);
-        for (dst, src) in frame.light.iter_mut().zip(&b.light) {
-            dst[at..at + n].copy_from_slice(src);
-        }
-        stats.visibility_counters.merge(&b.vis);
-        stats.shadow_counters.merge(&b.shadow);
+    for (vis, shadow) in &counters {
+        stats.visibility_counters.merge(vis);
+        stats.shadow_counters.merge(shadow);
     }
     stats.time_ms.insert("scan", ms(t.elapsed()));
     stats.time_ms.insert("total", ms(start.elapsed()));
