@@ -7,7 +7,7 @@
 use crate::error::Result;
 use crate::frame::Frame;
 use crate::scene::Scene;
-use crate::shading::Shader;
+use crate::shading::{RunShading, Shader};
 use crate::shadow::{ShadowContext, ShadowMethod};
 use crate::stats::{Counters, Stats};
 use crate::view::View;
@@ -122,6 +122,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
             let (mut vis, mut shadow) = (Counters::default(), Counters::default());
             let mut walker = shadows.walker();
             let mut lit = vec![0.0f32; w as usize];
+            let mut rs = RunShading::default();
             let mut self_shadowed = 0u64;
             visibility.walk(y0..y1, &mut vis, &mut |y, runs| {
                 walker.start_line(y);
@@ -131,6 +132,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
                     let poly = &scene.polygons[run.poly as usize];
                     id[a..b].fill(poly.face);
                     color[a..b].fill(shader.ambient(run.poly as usize));
+                    shader.begin_run(run, y, &mut rs);
                     for (l, samples) in ctx.samples.iter().enumerate() {
                         let share = 1.0 / samples.len() as f32;
                         for (s, sample) in samples.iter().enumerate() {
@@ -144,7 +146,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
                             for (f, &v) in light[l][a..b].iter_mut().zip(lit.iter()) {
                                 *f += v * share;
                             }
-                            shader.add_light(run.poly as usize, l, s, lit, &mut color[a..b]);
+                            shader.add_light(&mut rs, l, s, lit, &mut color[a..b]);
                         }
                     }
                 }

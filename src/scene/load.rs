@@ -123,6 +123,7 @@ struct RawMaterial {
     shininess: Option<Num>,
     model: Option<SpecularModel>,
     roughness: Option<Num>,
+    fresnel: Option<Num>,
     shading: Option<ShadingMode>,
 }
 
@@ -236,11 +237,12 @@ impl Scene {
                 shininess: m.shininess.map_or(d.shininess, |x| x.0 as f32),
                 model: m.model.unwrap_or(d.model),
                 roughness: m.roughness.map_or(d.roughness, |x| x.0 as f32),
+                fresnel: m.fresnel.map_or(d.fresnel, |x| x.0 as f32),
                 shading: m.shading.unwrap_or(d.shading),
                 ..d
             };
-            if mat.roughness <= 0.0 || mat.shininess < 0.0 {
-                return Err(cx.err(span, "roughness must be > 0 and shininess >= 0"));
+            if mat.roughness <= 0.0 || mat.shininess < 0.0 || !(0.0..=1.0).contains(&mat.fresnel) {
+                return Err(cx.err(span, "roughness must be > 0, shininess >= 0 and fresnel in [0, 1]"));
             }
             materials.push(mat);
         }

@@ -11,6 +11,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{classify_face, newell_normal, FaceShape, Plane};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// The pinhole camera of section 3.
@@ -128,6 +129,8 @@ pub struct Material {
     pub model: SpecularModel,
     /// Cook-Torrance roughness (Beckmann m).
     pub roughness: f32,
+    /// Cook-Torrance Fresnel reflectance at normal incidence F0 (Schlick); default 0.04.
+    pub fresnel: f32,
     /// Shading mode.
     pub shading: ShadingMode,
 }
@@ -145,6 +148,7 @@ impl Material {
             shininess: 32.0,
             model: SpecularModel::Phong,
             roughness: 0.3,
+            fresnel: 0.04,
             shading: ShadingMode::Flat,
         }
     }
@@ -467,15 +471,21 @@ impl Scene {
             let mesh = &obj.mesh;
             let world: Vec<DVec3> = mesh.positions.iter().map(|&p| m.transform_point3(p)).collect();
             let vn: Vec<DVec3> = mesh.normals.iter().map(|&n| (nm * n).normalize_or_zero()).collect();
-            // Averaged normals for faces without `vn`: area-weighted face normals per vertex.
+            // Averaged normals for faces without `vn`: area-weighted face normals summed over
+            // every face that shares the vertex's position (meshes often repeat a position
+            // along a texture seam; welding keeps the seam from showing).
+            let mut weld: HashMap<[u64; 3], usize> = HashMap::new();
+            let rep: Vec<usize> =
+                world.iter().enumerate().map(|(i, p)| *weld.entry(p.to_array().map(f64::to_bits)).or_insert(i)).collect();
             let mut avg = vec![DVec3::ZERO; world.len()];
             for f in mesh.faces.iter().filter(|f| f.normals.is_empty()) {
                 let pts: Vec<DVec3> = f.vertices.iter().map(|&v| world[v as usize]).collect();
                 let n = newell_normal(&pts);
                 for &v in &f.vertices {
-                    avg[v as usize] += n;
+                    avg[rep[v as usize]] += n;
                 }
             }
+            let avg: Vec<DVec3> = rep.iter().map(|&r| avg[r]).collect();
             let mut pts = Vec::new();
             for (fi, f) in mesh.faces.iter().enumerate() {
                 let face = self.face_count + fi as u32;
