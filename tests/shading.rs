@@ -174,7 +174,7 @@ fn area_light_half_lit_pixel() {
     // blocks exactly one sample for every floor point under it.
     let src = "[camera]\neye = [0.0, 1.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\nwidth = 64\nheight = 48\n\
                [render]\nambient = [0.0, 0.0, 0.0]\n\
-               [[material]]\nname = \"m\"\ncolor = [1.0, 1.0, 1.0]\nkd = 1.0\n\
+               [[material]]\nname = \"m\"\ncolor = [1.0, 1.0, 1.0]\nkd = 1.0\nshading = \"phong\"\n\
                [[light]]\nkind = \"area\"\ncorner = [-1.0, 2.0, -0.05]\nedge_u = [2.0, 0.0, 0.0]\nedge_v = [0.0, 0.0, 0.1]\nsamples = [2, 1]\n\
                [[object]]\npolygons = [[[-3.0,0.0,-3.0],[-3.0,0.0,3.0],[3.0,0.0,3.0],[3.0,0.0,-3.0]]]\nmaterial = \"m\"\n\
                [[object]]\npolygons = [[[0.0,0.2,-3.0],[0.0,0.2,3.0],[0.0,1.9,3.0],[0.0,1.9,-3.0]]]\nmaterial = \"m\"\n";
