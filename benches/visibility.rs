@@ -37,7 +37,7 @@ fn full_render(c: &mut Criterion) {
     g.sample_size(10).measurement_time(Duration::from_secs(3)).warm_up_time(Duration::from_millis(500));
     for (name, scene) in scenes().into_iter().filter(|(n, _)| n == "cubes10" || n == "quads16") {
         for m in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
-            let opts = RenderOptions { visibility: m, shadows: ShadowMethod::None, progress: false };
+            let opts = RenderOptions { visibility: m, shadows: ShadowMethod::None, ..Default::default() };
             g.bench_with_input(BenchmarkId::new(m.name(), &name), &scene, |b, s| b.iter(|| render(s, &opts).unwrap()));
         }
     }

@@ -5,7 +5,7 @@ fn main() {
     let opts = umbra::RenderOptions {
         visibility: args[2].parse().unwrap(),
         shadows: args[3].parse().unwrap(),
-        progress: false,
+        ..Default::default()
     };
     let n: u32 = args.get(4).map_or(5, |s| s.parse().unwrap());
     let t = std::time::Instant::now();

@@ -62,6 +62,35 @@ impl Frame {
         })
     }
 
+    /// Draws polygons over a colour image: tinted inside (by the even-odd rule, with the
+    /// shared scan converter) and outlined.
+    pub fn draw_outlines(img: &mut image::RgbImage, rings: &[Vec<glam::DVec2>], color: [u8; 3]) {
+        let (w, h) = img.dimensions();
+        let mut table = crate::scan::EdgeTable::new(h);
+        let blend = |p: &mut image::Rgb<u8>, a: f32| {
+            for (c, t) in p.0.iter_mut().zip(color) {
+                *c = (*c as f32 * (1.0 - a) + t as f32 * a).round() as u8;
+            }
+        };
+        for ring in rings {
+            crate::scan::for_each_span(&mut table, &[ring], w, h, 0..h, |y, x0, x1| {
+                for x in x0..x1 {
+                    blend(img.get_pixel_mut(x, y), 0.25);
+                }
+            });
+            for (i, a) in ring.iter().enumerate() {
+                let b = ring[(i + 1) % ring.len()];
+                let steps = (b - *a).abs().max_element().ceil().min(1e5) as usize + 1;
+                for k in 0..=steps {
+                    let p = *a + (b - *a) * (k as f64 / steps as f64);
+                    if p.x >= 0.0 && p.y >= 0.0 && p.x < w as f64 && p.y < h as f64 {
+                        blend(img.get_pixel_mut(p.x as u32, p.y as u32), 0.9);
+                    }
+                }
+            }
+        }
+    }
+
     /// Writes the colour image as PNG.
     pub fn save_png(&self, path: &Path, gamma: Option<f32>) -> Result<()> {
         self.save(self.color_image(gamma).into(), path)

@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use umbra::shadow::ShadowOptions;
 use umbra::{generate, render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 #[derive(Parser)]
@@ -34,8 +35,8 @@ struct RenderArgs {
     /// Hidden-surface stage: scanline (Watkins), zbuffer, or ray-cast (one ray per pixel).
     #[arg(long, default_value = "scanline", value_parser = parse_visibility)]
     visibility: VisibilityMethod,
-    /// Shadow stage: none, or ray-cast (exact per-pixel reference); the default is the
-    /// engine's recommended exact method.
+    /// Shadow stage: none, bouknight-kelley (projected shadow polygons, exact), or ray-cast
+    /// (exact per-pixel reference); the default is the engine's recommended exact method.
     #[arg(long, default_value = ShadowMethod::DEFAULT.name(), value_parser = parse_shadows)]
     shadows: ShadowMethod,
     /// Write the analysis buffers id.png and light<k>.png into this folder.
@@ -47,6 +48,19 @@ struct RenderArgs {
     /// Encode the image with this display gamma (for example 2.2); default: linear values.
     #[arg(long)]
     gamma: Option<f32>,
+    /// Bouknight-Kelley: project every pair, without the sphere prefilter (to measure it).
+    #[arg(long)]
+    no_prefilter: bool,
+    /// Draw the shadow stage's own polygons for the first light sample over the image
+    /// (shadow-polygons: Bouknight-Kelley's projections on their receivers).
+    #[arg(long, value_enum)]
+    debug: Option<Debug>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Debug {
+    /// The polygons the shadow stage walks, tinted and outlined.
+    ShadowPolygons,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -101,9 +115,16 @@ fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
             let scene = Scene::load(&a.scene)?;
-            let opts = RenderOptions { visibility: a.visibility, shadows: a.shadows, progress: true };
+            let shadow_options =
+                ShadowOptions { prefilter: !a.no_prefilter, keep_outlines: a.debug.is_some(), ..Default::default() };
+            let opts = RenderOptions { visibility: a.visibility, shadows: a.shadows, shadow_options, progress: true };
             let out = render(&scene, &opts)?;
-            out.frame.save_png(&a.output, a.gamma)?;
+            let mut img = out.frame.color_image(a.gamma);
+            if a.debug.is_some() {
+                umbra::Frame::draw_outlines(&mut img, &out.outlines, [255, 40, 200]);
+            }
+            img.save_with_format(&a.output, image::ImageFormat::Png)
+                .map_err(|e| umbra::Error::Image { path: a.output.clone(), source: e })?;
             if let Some(dir) = &a.aov {
                 out.frame.save_aovs(dir)?;
             }

@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::frame::Frame;
 use crate::scene::Scene;
 use crate::shading::{RunShading, Shader};
-use crate::shadow::{ShadowContext, ShadowMethod};
+use crate::shadow::{ShadowContext, ShadowMethod, ShadowOptions};
 use crate::stats::{Counters, Stats};
 use crate::view::View;
 use crate::visibility::VisibilityMethod;
@@ -26,6 +26,8 @@ pub struct RenderOptions {
     pub visibility: VisibilityMethod,
     /// The shadow stage.
     pub shadows: ShadowMethod,
+    /// Options of the shadow stages.
+    pub shadow_options: ShadowOptions,
     /// Show a progress bar on stderr when the render takes more than a second and stderr is
     /// a terminal.
     pub progress: bool,
@@ -33,7 +35,12 @@ pub struct RenderOptions {
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { visibility: VisibilityMethod::Scanline, shadows: ShadowMethod::DEFAULT, progress: false }
+        RenderOptions {
+            visibility: VisibilityMethod::Scanline,
+            shadows: ShadowMethod::DEFAULT,
+            shadow_options: ShadowOptions::default(),
+            progress: false,
+        }
     }
 }
 
@@ -44,6 +51,9 @@ pub struct Rendered {
     pub frame: Frame,
     /// Counters and times.
     pub stats: Stats,
+    /// The outlines of the shadow stage's polygons for the first light sample, when
+    /// `shadow_options.keep_outlines` asked for them.
+    pub outlines: Vec<Vec<glam::DVec2>>,
 }
 
 /// Lines per band: enough bands to keep every core busy, few enough that each band's setup
@@ -89,7 +99,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     stats.time_ms.insert("visibility_prepare", ms(t.elapsed()));
 
     let t = Instant::now();
-    let ctx = ShadowContext::new(scene, &view);
+    let ctx = ShadowContext::new(scene, &view, &screen, opts.shadow_options.clone());
     stats.light_samples = ctx.samples.iter().map(Vec::len).sum();
     let shadows = opts.shadows.prepare(&ctx, &mut stats.shadow_counters)?;
     stats.time_ms.insert("shadow_prepare", ms(t.elapsed()));
@@ -168,7 +178,8 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     }
     stats.time_ms.insert("scan", ms(t.elapsed()));
     stats.time_ms.insert("total", ms(start.elapsed()));
-    Ok(Rendered { frame, stats })
+    let outlines = shadows.outlines();
+    Ok(Rendered { frame, stats, outlines })
 }
 
 /// A progress bar that appears only after a second, and only on a terminal.

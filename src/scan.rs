@@ -192,6 +192,7 @@ pub struct ActiveEdges<'a> {
     incoming: Vec<(Crossing, u32)>,
     merged: Vec<(Crossing, u32)>,
     out: Vec<Crossing>,
+    current: Option<u32>,
     /// Edges that entered so far (a counter for the stats).
     pub entered: u64,
 }
@@ -221,6 +222,7 @@ impl<'a> ActiveEdges<'a> {
             incoming: Vec::new(),
             merged: Vec::new(),
             out: Vec::new(),
+            current: None,
             entered: 0,
         }
     }
@@ -280,7 +282,19 @@ impl<'a> ActiveEdges<'a> {
         }
         self.out.clear();
         self.out.extend(self.active.iter().map(|&(c, _)| c));
+        self.current = Some(line);
         Some((line, &self.out))
+    }
+
+    /// Steps forward to `line` (which must not be behind the last line walked) and gives its
+    /// crossings; none on lines the table does not reach.
+    pub fn advance_to(&mut self, line: u32) -> &[Crossing] {
+        while self.next <= line && self.next_line().is_some() {}
+        if self.current == Some(line) {
+            &self.out
+        } else {
+            &[]
+        }
     }
 
     /// Bytes held by the walker.

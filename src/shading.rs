@@ -224,7 +224,12 @@ impl<'a> Shader<'a> {
                 let (l, r) = (rs.crossings[2 * j], rs.crossings[2 * j + 1]);
                 let s = if r.u > l.u { ((u - l.u) / (r.u - l.u)).clamp(0.0, 1.0) } else { 0.5 };
                 let next = |k: u32| (k + 1) % n as u32;
-                [(l.k, (1.0 - l.t) * (1.0 - s)), (next(l.k), l.t * (1.0 - s)), (r.k, (1.0 - r.t) * s), (next(r.k), r.t * s)]
+                [
+                    (l.k, (1.0 - l.t) * (1.0 - s)),
+                    (next(l.k), l.t * (1.0 - s)),
+                    (r.k, (1.0 - r.t) * s),
+                    (next(r.k), r.t * s),
+                ]
             };
             rs.weights.push(w);
         }
@@ -325,7 +330,12 @@ mod tests {
     #[test]
     fn attenuation_and_spot_cone() {
         let light = Light {
-            kind: LightKind::Spot { position: DVec3::new(0.0, 2.0, 0.0), direction: -DVec3::Y, cutoff: 30.0, exponent: 2.0 },
+            kind: LightKind::Spot {
+                position: DVec3::new(0.0, 2.0, 0.0),
+                direction: -DVec3::Y,
+                cutoff: 30.0,
+                exponent: 2.0,
+            },
             color: Vec3::ONE,
             intensity: 1.0,
             attenuation: [1.0, 0.5, 0.25],

@@ -115,7 +115,10 @@ fn phong_highlight_peaks_at_the_mirror_point() {
             }
         }
     }
-    assert!((bx as f64 + 0.5 - at.x).abs() <= 1.0 && (by as f64 + 0.5 - at.y).abs() <= 1.0, "peak at ({bx},{by}), mirror point projects to {at}");
+    assert!(
+        (bx as f64 + 0.5 - at.x).abs() <= 1.0 && (by as f64 + 0.5 - at.y).abs() <= 1.0,
+        "peak at ({bx},{by}), mirror point projects to {at}"
+    );
     // At the mirror point itself R.V = 1: the value is the full specular plus diffuse.
     let m = s.material(0);
     let want = ambient() + lit_at(m, peak, DVec3::Y);
@@ -198,7 +201,10 @@ fn area_light_half_lit_pixel() {
 fn gouraud_equals_flat_when_vertex_normals_are_the_face_normal() {
     let mut flat = scene("phong", "flat", "");
     flat.materials[0].ks = 0.0;
-    flat.lights[0] = Light { kind: LightKind::Directional { direction: DVec3::new(0.3, -1.0, 0.2).normalize() }, ..flat.lights[0].clone() };
+    flat.lights[0] = Light {
+        kind: LightKind::Directional { direction: DVec3::new(0.3, -1.0, 0.2).normalize() },
+        ..flat.lights[0].clone()
+    };
     let mut gouraud = flat.clone();
     gouraud.materials[0].shading = ShadingMode::Gouraud;
     // Inline polygons share no vertices: their averaged normals are the face normal.
@@ -222,8 +228,12 @@ fn phong_shading_of_a_sphere_converges_to_the_analytic_sphere() {
         let mut cam = umbra::scene::Camera::new(DVec3::new(0.0, 0.5, 4.0), DVec3::ZERO);
         cam.width = 96;
         cam.height = 96;
-        let light =
-            Light { kind: LightKind::Directional { direction: DVec3::new(-0.5, -0.7, -0.6).normalize() }, color: Vec3::ONE, intensity: 1.0, attenuation: [1.0, 0.0, 0.0] };
+        let light = Light {
+            kind: LightKind::Directional { direction: DVec3::new(-0.5, -0.7, -0.6).normalize() },
+            color: Vec3::ONE,
+            intensity: 1.0,
+            attenuation: [1.0, 0.0, 0.0],
+        };
         let obj = umbra::scene::Object {
             name: None,
             material: 0,

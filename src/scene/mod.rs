@@ -475,8 +475,11 @@ impl Scene {
             // every face that shares the vertex's position (meshes often repeat a position
             // along a texture seam; welding keeps the seam from showing).
             let mut weld: HashMap<[u64; 3], usize> = HashMap::new();
-            let rep: Vec<usize> =
-                world.iter().enumerate().map(|(i, p)| *weld.entry(p.to_array().map(f64::to_bits)).or_insert(i)).collect();
+            let rep: Vec<usize> = world
+                .iter()
+                .enumerate()
+                .map(|(i, p)| *weld.entry(p.to_array().map(f64::to_bits)).or_insert(i))
+                .collect();
             let mut avg = vec![DVec3::ZERO; world.len()];
             for f in mesh.faces.iter().filter(|f| f.normals.is_empty()) {
                 let pts: Vec<DVec3> = f.vertices.iter().map(|&v| world[v as usize]).collect();

@@ -6,15 +6,34 @@
 //! is in shadow from it — Bouknight and Kelley's self-shadowing test) is applied once by the
 //! pipeline, before any stage is asked; stages only answer for runs the rule leaves lit.
 
+mod bouknight_kelley;
+mod overlay;
 mod ray_cast;
 
+pub use bouknight_kelley::BouknightKelley;
 pub use ray_cast::RayCastShadows;
 
 use crate::error::{Error, Result};
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
-use crate::view::View;
+use crate::view::{ScreenPolygon, View};
 use crate::visibility::Run;
+
+/// Options of the shadow stages (each stage reads its own).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShadowOptions {
+    /// Bouknight-Kelley: use the sphere prefilter (default true).
+    pub prefilter: bool,
+    /// Keep the screen outlines of the stage's polygons (shadow polygons, detail polygons)
+    /// for drawing them over the image.
+    pub keep_outlines: bool,
+}
+
+impl Default for ShadowOptions {
+    fn default() -> Self {
+        ShadowOptions { prefilter: true, keep_outlines: false }
+    }
+}
 
 /// What every shadow stage is prepared from.
 pub struct ShadowContext<'a> {
@@ -22,6 +41,12 @@ pub struct ShadowContext<'a> {
     pub scene: &'a Scene,
     /// The view.
     pub view: &'a View,
+    /// The scene's polygons in screen space (those the view keeps).
+    pub screen: &'a [ScreenPolygon],
+    /// `on_screen[i]`: whether scene polygon `i` survives clipping (can be seen at all).
+    pub on_screen: Vec<bool>,
+    /// Stage options.
+    pub options: ShadowOptions,
     /// Each light's samples (`samples[light][sample]`).
     pub samples: Vec<Vec<LightSample>>,
     /// The scene's size (diagonal of its bounds), for tolerances.
@@ -29,11 +54,26 @@ pub struct ShadowContext<'a> {
 }
 
 impl<'a> ShadowContext<'a> {
-    /// The context for rendering `scene` from `view`.
-    pub fn new(scene: &'a Scene, view: &'a View) -> Self {
+    /// The context for rendering `scene` from `view`, whose screen polygons are `screen`.
+    pub fn new(scene: &'a Scene, view: &'a View, screen: &'a [ScreenPolygon], options: ShadowOptions) -> Self {
         let samples = scene.lights.iter().map(|l| l.samples()).collect();
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
-        ShadowContext { scene, view, samples, extent }
+        let mut on_screen = vec![false; scene.polygons.len()];
+        for p in screen {
+            on_screen[p.poly as usize] = true;
+        }
+        ShadowContext { scene, view, screen, on_screen, options, samples, extent }
+    }
+
+    /// Every (light, sample) pair, in order: the flat index of sample `s` of light `l` is
+    /// `sample_index(l, s)`.
+    pub fn all_samples(&self) -> impl Iterator<Item = (usize, usize, LightSample)> + '_ {
+        self.samples.iter().enumerate().flat_map(|(l, ss)| ss.iter().enumerate().map(move |(s, &x)| (l, s, x)))
+    }
+
+    /// The flat index of sample `s` of light `l`.
+    pub fn sample_index(&self, l: usize, s: usize) -> usize {
+        self.samples[..l].iter().map(Vec::len).sum::<usize>() + s
     }
 }
 
@@ -41,6 +81,13 @@ impl<'a> ShadowContext<'a> {
 pub trait ShadowStage: Sync {
     /// A walker for one band of lines; it is called in increasing line order.
     fn walker(&self) -> Box<dyn ShadowWalker + '_>;
+
+    /// The screen outlines of the polygons the stage walks for the first sample of the first
+    /// light (shadow polygons, detail polygons, shadow-volume polygons), when the options
+    /// asked to keep them; for drawing over the image.
+    fn outlines(&self) -> Vec<Vec<glam::DVec2>> {
+        Vec::new()
+    }
 }
 
 /// Answers, line by line, which pixels of each visible run a light sample reaches.
@@ -64,6 +111,8 @@ pub enum ShadowMethod {
     None,
     /// One shadow ray per pixel and light sample (the exact reference).
     RayCast,
+    /// Appel / Bouknight-Kelley projected shadow polygons, scan segment by scan segment.
+    BouknightKelley,
 }
 
 impl ShadowMethod {
@@ -71,13 +120,14 @@ impl ShadowMethod {
     pub const DEFAULT: ShadowMethod = ShadowMethod::RayCast;
 
     /// Every method.
-    pub const ALL: [ShadowMethod; 2] = [ShadowMethod::None, ShadowMethod::RayCast];
+    pub const ALL: [ShadowMethod; 3] = [ShadowMethod::None, ShadowMethod::BouknightKelley, ShadowMethod::RayCast];
 
     /// The method's name on the command line.
     pub fn name(self) -> &'static str {
         match self {
             ShadowMethod::None => "none",
             ShadowMethod::RayCast => "ray-cast",
+            ShadowMethod::BouknightKelley => "bouknight-kelley",
         }
     }
 
@@ -91,6 +141,7 @@ impl ShadowMethod {
         Ok(match self {
             ShadowMethod::None => Box::new(NoShadows),
             ShadowMethod::RayCast => Box::new(RayCastShadows::new(ctx, counters)),
+            ShadowMethod::BouknightKelley => Box::new(BouknightKelley::new(ctx, counters)),
         })
     }
 }

@@ -29,7 +29,7 @@ pub fn load_scaled(path: &PathBuf, max_width: u32) -> Scene {
 }
 
 pub fn frame(scene: &Scene, visibility: VisibilityMethod, shadows: ShadowMethod) -> Frame {
-    let opts = RenderOptions { visibility, shadows, progress: false };
+    let opts = RenderOptions { visibility, shadows, ..Default::default() };
     render(scene, &opts).unwrap_or_else(|e| panic!("{e}")).frame
 }
 
@@ -85,4 +85,20 @@ pub fn assert_light_agree(reference: &Frame, got: &Frame, label: &str) -> usize 
         &bad[..bad.len().min(10)]
     );
     compared
+}
+
+/// Interior pixels of `reference` (as in [`assert_light_agree`]) where some light is not
+/// fully lit: evidence that a test compares shadows, not just lit floors.
+pub fn shadowed_interior(reference: &Frame) -> usize {
+    let mut n = 0;
+    for y in 0..reference.height {
+        for x in 0..reference.width {
+            let k = (y * reference.width + x) as usize;
+            if reference.is_interior(x, y) && reference.id[k] != u32::MAX && reference.light.iter().any(|l| l[k] < 1.0)
+            {
+                n += 1;
+            }
+        }
+    }
+    n
 }

@@ -1,0 +1,409 @@
+//! The scan-line shadow algorithm of Appel (1968) and Bouknight & Kelley (1970), as seed 004
+//! describes it.
+//!
+//! For every light sample:
+//!
+//! 1. **Pairs.** Polygon A can shadow polygon B only by its projection from the light onto
+//!    B's plane, A'. There are n(n−1) ordered pairs (A, B) for n polygons.
+//! 2. **The sphere prefilter.** Every polygon is projected onto a sphere around the light and
+//!    its extent kept (a bounding cone of the directions to its vertices, binned by
+//!    spherical coordinates with the azimuth's wrap-around handled). Pairs whose extents do
+//!    not overlap cannot shadow each other and are never projected. For a directional light
+//!    the "sphere" is the plane across the light's direction, and the extents are boxes there.
+//!    Pairs where A lies wholly behind B as seen from the light are dropped too.
+//! 3. **Projection.** Only the part of A between the light and B's plane can shadow B: A is
+//!    clipped by the plane through the light parallel to B and by B's plane, and also by the
+//!    pyramid from the light over B's bounding rectangle (what falls outside it cannot fall
+//!    on B, and this keeps the projection finite), then projected from the light onto B's
+//!    plane (`Q = L − (P − L)(N·L + d)/(N·(P − L))`, seed 003; a parallel projection along
+//!    the light's direction for a directional light, seed 004's `M_par`). The shadow polygon
+//!    A' is then put through the camera into screen space, still attached to B.
+//! 4. **Scan segments.** For each visible run on B, the shadow polygons on B are walked with
+//!    the shared edge and active-edge tables ([`super::overlay`]). Then, recursively: if no
+//!    shadow polygon touches the segment it is lit; if one covers it fully it is in shadow;
+//!    if one covers it partly, the segment is split at that polygon's edges and each part is
+//!    examined again.
+//!
+//! Self-shadowing (B's seen side facing away from the light) needs no projection: the
+//! pipeline's same-side rule answers it before this stage is asked (see [`super`]).
+//!
+//! Degenerate input: a light on A's plane makes A's shadow zero-area (A is skipped as a
+//! caster for that sample); a light on B's plane leaves B unlit by the same-side rule;
+//! polygons on the far side of the light from B are clipped away by the plane through the
+//! light; zero-area projections are dropped. None of these divide by zero.
+
+use super::overlay::{Interval, Overlay, OverlayWalker};
+use super::{ShadowContext, ShadowStage, ShadowWalker};
+use crate::geometry::{clip_polygon, newell_normal, Plane};
+use crate::scene::{LightSample, Scene};
+use crate::stats::Counters;
+use crate::visibility::Run;
+use glam::{DVec2, DVec3};
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// The prepared stage: for each light sample, the shadow polygons on their receivers.
+pub struct BouknightKelley<'a> {
+    ctx: &'a ShadowContext<'a>,
+    /// `shadows[sample_index(l, s)]`.
+    shadows: Vec<Overlay>,
+}
+
+impl<'a> BouknightKelley<'a> {
+    /// Makes the shadow polygons of every light sample.
+    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
+        let shadows = ctx.all_samples().map(|(_, _, sample)| shadow_polygons(ctx, sample, counters)).collect();
+        BouknightKelley { ctx, shadows }
+    }
+}
+
+/// Steps 1-3 for one light sample.
+fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Counters) -> Overlay {
+    let scene = ctx.scene;
+    let n = scene.polygons.len();
+    counters.add("pairs", (n as u64) * (n as u64).saturating_sub(1));
+    // Receivers: polygons that can be seen, with the light on their seen side. Casters:
+    // shadow-casting polygons not edge-on to the light.
+    let receiver: Vec<bool> =
+        (0..n).map(|i| ctx.on_screen[i] && sample.on_seen_side(&scene.polygons[i].plane, ctx.view.eye)).collect();
+    let caster: Vec<bool> = (0..n).map(|i| scene.casts_shadows(i) && !edge_on(scene, i, sample, ctx.extent)).collect();
+
+    let t = Instant::now();
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    let role = |a: usize, b: usize| caster[a] && receiver[b] && scene.polygons[a].face != scene.polygons[b].face;
+    if ctx.options.prefilter {
+        for (i, j) in sphere_prefilter(scene, sample) {
+            let (i, j) = (i as usize, j as usize);
+            if role(i, j) {
+                pairs.push((i as u32, j as u32));
+            }
+            if role(j, i) {
+                pairs.push((j as u32, i as u32));
+            }
+        }
+        counters.add("pairs_kept_by_prefilter", pairs.len() as u64);
+    } else {
+        for b in (0..n).filter(|&b| receiver[b]) {
+            pairs.extend((0..n).filter(|&a| role(a, b)).map(|a| (a as u32, b as u32)));
+        }
+    }
+    counters.add("prefilter_us", t.elapsed().as_micros() as u64);
+    counters.add("pairs_with_roles", pairs.len() as u64);
+
+    let t = Instant::now();
+    let mut overlay = Overlay::new(ctx.view.height, ctx.options.keep_outlines);
+    let mut proj = Projector::default();
+    let (mut view_scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
+    let (mut behind, mut zero) = (0u64, 0u64);
+    for (a, b) in pairs {
+        let (a, b) = (a as usize, b as usize);
+        let plane = scene.polygons[b].plane;
+        let side = light_side(&plane, sample);
+        if scene.verts(a).iter().all(|&v| plane.distance(v) * side <= 0.0) {
+            behind += 1;
+            continue;
+        }
+        if proj.shadow_polygon(scene, a, b, sample) {
+            if ctx.view.clip_project(&proj.a, &mut view_scratch, &mut ring) {
+                overlay.add(b as u32, &ring);
+            }
+        } else {
+            zero += 1;
+        }
+    }
+    overlay.finish();
+    counters.add("pairs_dropped_behind", behind);
+    counters.add("projections_empty", zero);
+    counters.add("shadow_polygons", overlay.len() as u64);
+    counters.add("projection_us", t.elapsed().as_micros() as u64);
+    overlay
+}
+
+/// +1 or −1: the sign of `plane.distance` on the light's side of the plane.
+fn light_side(plane: &Plane, sample: LightSample) -> f64 {
+    let d = match sample {
+        LightSample::Point(s) => plane.distance(s),
+        LightSample::Directional(dir) => -plane.n.dot(dir),
+    };
+    if d >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// Whether the light lies in polygon `i`'s plane (to a relative 1e-12): its shadow has no area.
+fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> bool {
+    let plane = &scene.polygons[i].plane;
+    match sample {
+        LightSample::Point(s) => plane.distance(s).abs() <= 1e-12 * extent,
+        LightSample::Directional(d) => plane.n.dot(d).abs() <= 1e-12,
+    }
+}
+
+/// Scratch space for step 3.
+#[derive(Default)]
+struct Projector {
+    /// The shadow polygon being made.
+    a: Vec<DVec3>,
+    b: Vec<DVec3>,
+}
+
+impl Projector {
+    /// Step 3: the shadow of polygon `a` on the plane of polygon `b`, into `self.a` in world
+    /// space; `false` when nothing of `a` lies between the light and `b` within `b`'s bounds,
+    /// or the projection has no area.
+    fn shadow_polygon(&mut self, scene: &Scene, a: usize, b: usize, sample: LightSample) -> bool {
+        let plane = scene.polygons[b].plane;
+        let side = light_side(&plane, sample);
+        self.a.clear();
+        self.a.extend_from_slice(scene.verts(a));
+        // The part of A on the light's side of B's plane ...
+        self.clip(|x| plane.distance(x) * side);
+        // ... and, for a point light, on B's side of the plane through the light parallel to B.
+        if let LightSample::Point(s) = sample {
+            let ds = plane.distance(s);
+            self.clip(|x| (ds - plane.distance(x)) * side);
+        }
+        // ... within the pyramid (prism, for a directional light) from the light over B's
+        // bounding rectangle.
+        let rect = bounding_rectangle(scene.verts(b), &plane);
+        let center = rect.iter().sum::<DVec3>() / 4.0;
+        for k in 0..4 {
+            let (q0, q1) = (rect[k], rect[(k + 1) % 4]);
+            let (origin, m) = match sample {
+                LightSample::Point(s) => (s, (q0 - s).cross(q1 - s)),
+                LightSample::Directional(d) => (q0, (q1 - q0).cross(d)),
+            };
+            let m = if m.dot(center - origin) >= 0.0 { m } else { -m };
+            self.clip(|x| m.dot(x - origin));
+        }
+        if self.a.is_empty() {
+            return false;
+        }
+        // Project onto B's plane from the light.
+        for x in &mut self.a {
+            *x = match sample {
+                LightSample::Point(s) => s + (*x - s) * (-plane.distance(s) / plane.n.dot(*x - s)),
+                LightSample::Directional(d) => *x - d * (plane.distance(*x) / plane.n.dot(d)),
+            };
+        }
+        let area2 = newell_normal(&self.a).length();
+        let size = rect[0].distance(rect[2]);
+        area2 > 1e-12 * size * size && self.a.iter().all(|x| x.is_finite())
+    }
+
+    fn clip(&mut self, dist: impl Fn(DVec3) -> f64) {
+        if !self.a.is_empty() && self.a.iter().any(|&x| dist(x) < 0.0) {
+            clip_polygon(&self.a, dist, &mut self.b);
+            std::mem::swap(&mut self.a, &mut self.b);
+        }
+    }
+}
+
+/// The corners of the smallest rectangle in `plane` around `verts` (axes: any pair of unit
+/// vectors across the normal), grown by a relative 1e-9 so B's own edges are inside.
+fn bounding_rectangle(verts: &[DVec3], plane: &Plane) -> [DVec3; 4] {
+    let u = plane.n.any_orthonormal_vector();
+    let v = plane.n.cross(u);
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    for p in verts {
+        let q = DVec2::new(p.dot(u), p.dot(v));
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    let grow = (hi - lo).max_element() * 1e-9;
+    let (lo, hi) = (lo - grow, hi + grow);
+    let o = -plane.d * plane.n;
+    [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].map(|c| o + c.x * u + c.y * v)
+}
+
+/// A polygon's extent as the light sees it.
+#[derive(Debug, Clone, Copy)]
+struct Extent {
+    /// Boxes in the 2D domain of [`sphere_prefilter`] (two when the azimuth wraps).
+    boxes: [Option<[f64; 4]>; 2],
+    /// Point lights: the bounding cone's axis and half-angle (π covers everything).
+    cone: (DVec3, f64),
+}
+
+/// Step 2: the unordered pairs of polygons whose extents on the sphere around the light
+/// overlap (for a directional light, on the plane across it). Polygons are binned into a
+/// grid over the extent domain (polar angle × azimuth, or the plane's two axes); a pair is
+/// tested once per cell it shares and kept when the exact extents overlap.
+fn sphere_prefilter(scene: &Scene, sample: LightSample) -> Vec<(u32, u32)> {
+    let n = scene.polygons.len();
+    let extents: Vec<Extent> = (0..n).map(|i| extent(scene.verts(i), sample)).collect();
+    // The domain: [0, π] × [−π, π] on the sphere; the bounds of the boxes on the plane.
+    let domain = match sample {
+        LightSample::Point(_) => [0.0, -PI, PI, PI],
+        LightSample::Directional(_) => extents
+            .iter()
+            .flat_map(|e| e.boxes.iter().flatten())
+            .fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |d, b| {
+                [d[0].min(b[0]), d[1].min(b[1]), d[2].max(b[2]), d[3].max(b[3])]
+            }),
+    };
+    let g = ((n as f64).sqrt().ceil() as usize).clamp(4, 1024);
+    let (w, h) = ((domain[2] - domain[0]).max(1e-300), (domain[3] - domain[1]).max(1e-300));
+    let cell = |v: f64, lo: f64, size: f64| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
+    let mut cells: Vec<Vec<u32>> = vec![Vec::new(); g * g];
+    for (i, e) in extents.iter().enumerate() {
+        for b in e.boxes.iter().flatten() {
+            let (c0, c1) = (cell(b[0], domain[0], w), cell(b[2], domain[0], w));
+            let (r0, r1) = (cell(b[1], domain[1], h), cell(b[3], domain[1], h));
+            for c in c0..=c1 {
+                for r in r0..=r1 {
+                    cells[c * g + r].push(i as u32);
+                }
+            }
+        }
+    }
+    let mut pairs: Vec<u64> = Vec::new();
+    for members in &cells {
+        for (k, &i) in members.iter().enumerate() {
+            for &j in &members[k + 1..] {
+                if i != j {
+                    pairs.push(((i.min(j) as u64) << 32) | i.max(j) as u64);
+                }
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
+        .into_iter()
+        .map(|p| ((p >> 32) as u32, p as u32))
+        .filter(|&(i, j)| match sample {
+            LightSample::Point(_) => {
+                let (a, b) = (extents[i as usize].cone, extents[j as usize].cone);
+                a.1 + b.1 >= PI || a.0.dot(b.0).clamp(-1.0, 1.0).acos() <= a.1 + b.1
+            }
+            LightSample::Directional(_) => true,
+        })
+        .collect()
+}
+
+/// A polygon's extent: for a point light, the cone from the light around the directions to
+/// its vertices (a polygon's directions all lie inside a cone of half-angle under 90° that
+/// holds its vertices' directions), as boxes in polar angle θ (from +Y) and azimuth φ; for a
+/// directional light, the box of its vertices on the plane across the light.
+fn extent(verts: &[DVec3], sample: LightSample) -> Extent {
+    match sample {
+        LightSample::Point(s) => {
+            let full = Extent { boxes: [Some([0.0, -PI, PI, PI]), None], cone: (DVec3::Y, PI) };
+            let dirs: smallvec::SmallVec<[DVec3; 8]> = verts.iter().map(|&v| (v - s).normalize_or_zero()).collect();
+            let axis = dirs.iter().sum::<DVec3>().normalize_or_zero();
+            if axis == DVec3::ZERO || dirs.contains(&DVec3::ZERO) {
+                return full;
+            }
+            let half = dirs.iter().map(|d| d.dot(axis).clamp(-1.0, 1.0).acos()).fold(0.0, f64::max) + 1e-9;
+            if half >= PI / 2.0 {
+                return full;
+            }
+            let theta = axis.y.clamp(-1.0, 1.0).acos();
+            let phi = axis.z.atan2(axis.x);
+            let (t0, t1) = (theta - half, theta + half);
+            if t0 <= 0.0 || t1 >= PI {
+                return Extent { boxes: [Some([t0.max(0.0), -PI, t1.min(PI), PI]), None], cone: (axis, half) };
+            }
+            let dphi = (half.sin() / theta.sin()).min(1.0).asin() + 1e-9;
+            let (p0, p1) = (phi - dphi, phi + dphi);
+            let boxes = if p0 < -PI {
+                [Some([t0, p0 + 2.0 * PI, t1, PI]), Some([t0, -PI, t1, p1])]
+            } else if p1 > PI {
+                [Some([t0, p0, t1, PI]), Some([t0, -PI, t1, p1 - 2.0 * PI])]
+            } else {
+                [Some([t0, p0, t1, p1]), None]
+            };
+            Extent { boxes, cone: (axis, half) }
+        }
+        LightSample::Directional(d) => {
+            let u = d.any_orthonormal_vector();
+            let v = d.cross(u);
+            let b = verts.iter().fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |b, p| {
+                let (x, y) = (p.dot(u), p.dot(v));
+                [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)]
+            });
+            Extent { boxes: [Some(b), None], cone: (d, PI) }
+        }
+    }
+}
+
+impl ShadowStage for BouknightKelley<'_> {
+    fn outlines(&self) -> Vec<Vec<DVec2>> {
+        self.shadows.first().map_or_else(Vec::new, |o| o.rings().to_vec())
+    }
+
+    fn walker(&self) -> Box<dyn ShadowWalker + '_> {
+        Box::new(Walker {
+            walkers: self.shadows.iter().map(|o| o.walker(0..self.ctx.view.height)).collect(),
+            stage: self,
+            intervals: Vec::new(),
+            segments: 0,
+            splits: 0,
+            depth_max: 0,
+        })
+    }
+}
+
+struct Walker<'s> {
+    stage: &'s BouknightKelley<'s>,
+    walkers: Vec<OverlayWalker<'s>>,
+    intervals: Vec<Interval>,
+    segments: u64,
+    splits: u64,
+    depth_max: u32,
+}
+
+impl Walker<'_> {
+    /// Step 4 on segment `a..b` of a run starting at pixel `x0`: lit (1) or shadowed (0) into
+    /// `out[a - x0 .. b - x0]`, given the shadow polygons' intervals that may touch it.
+    fn segment(&mut self, a: u32, b: u32, candidates: &[Interval], depth: u32, x0: u32, out: &mut [f32]) {
+        self.segments += 1;
+        self.depth_max = self.depth_max.max(depth);
+        let touching: smallvec::SmallVec<[Interval; 8]> =
+            candidates.iter().copied().filter(|iv| iv.start < b && iv.end > a).collect();
+        let range = (a - x0) as usize..(b - x0) as usize;
+        // No shadow polygon touches the segment: normal (lit).
+        let Some(first) = touching.first() else {
+            out[range].fill(1.0);
+            return;
+        };
+        // One covers it fully: in shadow.
+        if touching.iter().any(|iv| iv.start <= a && iv.end >= b) {
+            out[range].fill(0.0);
+            return;
+        }
+        // One covers it partly: split at its edges and examine the parts.
+        self.splits += 1;
+        let cuts = [a, first.start.max(a), first.end.min(b), b];
+        for w in cuts.windows(2) {
+            if w[0] < w[1] {
+                self.segment(w[0], w[1], &touching, depth + 1, x0, out);
+            }
+        }
+    }
+}
+
+impl ShadowWalker for Walker<'_> {
+    fn start_line(&mut self, line: u32) {
+        for w in &mut self.walkers {
+            w.advance_to(line);
+        }
+    }
+
+    fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
+        let k = self.stage.ctx.sample_index(light, sample);
+        let mut intervals = std::mem::take(&mut self.intervals);
+        self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut intervals);
+        self.segment(run.x0, run.x1, &intervals, 0, run.x0, lit);
+        self.intervals = intervals;
+    }
+
+    fn finish(&mut self, counters: &mut Counters) {
+        counters.add("segments_examined", self.segments);
+        counters.add("segment_splits", self.splits);
+        counters.add("recursion_depth_max", self.depth_max as u64);
+    }
+}
