@@ -115,8 +115,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
             let scene = Scene::load(&a.scene)?;
-            let shadow_options =
-                ShadowOptions { prefilter: !a.no_prefilter, keep_outlines: a.debug.is_some(), ..Default::default() };
+            let shadow_options = ShadowOptions { prefilter: !a.no_prefilter, keep_outlines: a.debug.is_some() };
             let opts = RenderOptions { visibility: a.visibility, shadows: a.shadows, shadow_options, progress: true };
             let out = render(&scene, &opts)?;
             let mut img = out.frame.color_image(a.gamma);

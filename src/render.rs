@@ -1,8 +1,9 @@
 //! The pipeline: scene -> view -> visibility runs -> shadow -> shading -> frame.
 //!
-//! The frame is cut into bands of lines rendered in parallel (rayon); within a band the
-//! visibility stage and the shadow walker step down the lines in order, as a scanline
-//! renderer does, and each run is shaded as soon as it is known.
+//! Visibility resolves every line into runs first (in parallel bands of lines); the shadow
+//! stage is then prepared knowing which polygons are seen; finally the frame is shaded in
+//! parallel bands, each band's shadow walker stepping down its lines in order as a scanline
+//! renderer does.
 
 use crate::error::Result;
 use crate::frame::Frame;
@@ -96,10 +97,12 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
 
     let t = Instant::now();
     let visibility = opts.visibility.prepare(scene, &view, &screen, &mut stats.visibility_counters);
-    stats.time_ms.insert("visibility_prepare", ms(t.elapsed()));
+    let runs = crate::visibility::resolve(&*visibility, h, &mut stats.visibility_counters);
+    drop(visibility);
+    stats.time_ms.insert("visibility", ms(t.elapsed()));
 
     let t = Instant::now();
-    let ctx = ShadowContext::new(scene, &view, &screen, opts.shadow_options.clone());
+    let ctx = ShadowContext::new(scene, &view, &runs, opts.shadow_options.clone());
     stats.light_samples = ctx.samples.iter().map(Vec::len).sum();
     let shadows = opts.shadows.prepare(&ctx, &mut stats.shadow_counters)?;
     stats.time_ms.insert("shadow_prepare", ms(t.elapsed()));
@@ -124,17 +127,17 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
         })
         .collect();
     let progress = Mutex::new(Progress::new(opts.progress, h as u64));
-    let counters: Vec<(Counters, Counters)> = jobs
+    let counters: Vec<Counters> = jobs
         .into_par_iter()
         .map(|out| {
             let Band { y0, color, id, mut light } = out;
             let y1 = y0 + (id.len() / w as usize) as u32;
-            let (mut vis, mut shadow) = (Counters::default(), Counters::default());
+            let mut shadow = Counters::default();
             let mut walker = shadows.walker();
             let mut lit = vec![0.0f32; w as usize];
             let mut rs = RunShading::default();
             let mut self_shadowed = 0u64;
-            visibility.walk(y0..y1, &mut vis, &mut |y, runs| {
+            for (y, runs) in (y0..y1).zip(&runs.lines[y0 as usize..y1 as usize]) {
                 walker.start_line(y);
                 let row = ((y - y0) * w) as usize;
                 for run in runs {
@@ -160,23 +163,22 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
                         }
                     }
                 }
-            });
+            }
             walker.finish(&mut shadow);
             shadow.add("self_shadowed_runs", self_shadowed);
             if let Ok(mut p) = progress.lock() {
                 p.advance((y1 - y0) as u64);
             }
-            (vis, shadow)
+            shadow
         })
         .collect();
     if let Ok(p) = progress.lock() {
         p.finish();
     }
-    for (vis, shadow) in &counters {
-        stats.visibility_counters.merge(vis);
+    for shadow in &counters {
         stats.shadow_counters.merge(shadow);
     }
-    stats.time_ms.insert("scan", ms(t.elapsed()));
+    stats.time_ms.insert("shading", ms(t.elapsed()));
     stats.time_ms.insert("total", ms(start.elapsed()));
     let outlines = shadows.outlines();
     Ok(Rendered { frame, stats, outlines })

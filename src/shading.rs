@@ -124,7 +124,7 @@ pub struct RunShading {
     /// +1 or -1: turns the polygon's normals toward the viewer.
     flip: f64,
     centroid: DVec3,
-    /// World point seen at each pixel.
+    /// World point seen at each pixel (Gouraud and Phong modes).
     points: Vec<DVec3>,
     /// Each pixel's value as weights of up to four of the polygon's vertices.
     weights: Vec<[(u32, f64); 4]>,
@@ -164,13 +164,13 @@ impl<'a> Shader<'a> {
         rs.poly = poly;
         rs.mode = self.scene.material(poly).shading;
         rs.flip = if plane.distance(self.view.eye) >= 0.0 { 1.0 } else { -1.0 };
-        let yc = line as f64 + 0.5;
-        rs.points.clear();
-        rs.points.extend((run.x0..run.x1).map(|x| self.view.point_on(plane, x as f64 + 0.5, yc)));
         if rs.mode == ShadingMode::Flat {
             rs.centroid = centroid(self.scene.verts(poly));
             return;
         }
+        let yc = line as f64 + 0.5;
+        rs.points.clear();
+        rs.points.extend((run.x0..run.x1).map(|x| self.view.point_on(plane, x as f64 + 0.5, yc)));
         self.interpolation_weights(yc, rs);
         if rs.mode == ShadingMode::Phong {
             let vn = self.scene.vertex_normals(poly);

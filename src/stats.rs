@@ -57,7 +57,8 @@ pub struct Stats {
     pub visibility_counters: Counters,
     /// Shadow counters.
     pub shadow_counters: Counters,
-    /// Milliseconds per step: `view`, `visibility_prepare`, `shadow_prepare`, `scan`
-    /// (visibility walk + shadow + shading, all lines), `total`.
+    /// Milliseconds per step (wall clock): `view` (clipping and projection), `visibility`
+    /// (preparing the stage and resolving every line into runs), `shadow_prepare`,
+    /// `shading` (the shadow stage's walk and the shading of every run), `total`.
     pub time_ms: BTreeMap<&'static str, f64>,
 }

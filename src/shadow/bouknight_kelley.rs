@@ -39,6 +39,7 @@ use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::visibility::Run;
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -57,66 +58,101 @@ impl<'a> BouknightKelley<'a> {
     }
 }
 
-/// Steps 1-3 for one light sample.
+/// Steps 1-3 for one light sample. Receivers are the polygons seen at some pixel, with the
+/// light on their seen side; each gathers its candidate casters (through the prefilter, or
+/// all of them), drops those wholly behind it, and projects the rest. Receivers are
+/// independent, so they are worked on in parallel.
 fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Counters) -> Overlay {
     let scene = ctx.scene;
     let n = scene.polygons.len();
     counters.add("pairs", (n as u64) * (n as u64).saturating_sub(1));
-    // Receivers: polygons that can be seen, with the light on their seen side. Casters:
-    // shadow-casting polygons not edge-on to the light.
-    let receiver: Vec<bool> =
-        (0..n).map(|i| ctx.on_screen[i] && sample.on_seen_side(&scene.polygons[i].plane, ctx.view.eye)).collect();
-    let caster: Vec<bool> = (0..n).map(|i| scene.casts_shadows(i) && !edge_on(scene, i, sample, ctx.extent)).collect();
+    let receivers: Vec<u32> = (0..n as u32)
+        .filter(|&i| ctx.visible[i as usize] && sample.on_seen_side(&scene.polygons[i as usize].plane, ctx.view.eye))
+        .collect();
+    let casters: Vec<u32> = (0..n as u32)
+        .filter(|&i| scene.casts_shadows(i as usize) && !edge_on(scene, i as usize, sample, ctx.extent))
+        .collect();
+    counters.add("receivers", receivers.len() as u64);
+    counters.add("casters", casters.len() as u64);
+    counters.add("pairs_with_roles", receivers.len() as u64 * casters.len() as u64);
 
     let t = Instant::now();
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
-    let role = |a: usize, b: usize| caster[a] && receiver[b] && scene.polygons[a].face != scene.polygons[b].face;
-    if ctx.options.prefilter {
-        for (i, j) in sphere_prefilter(scene, sample) {
-            let (i, j) = (i as usize, j as usize);
-            if role(i, j) {
-                pairs.push((i as u32, j as u32));
-            }
-            if role(j, i) {
-                pairs.push((j as u32, i as u32));
-            }
-        }
-        counters.add("pairs_kept_by_prefilter", pairs.len() as u64);
-    } else {
-        for b in (0..n).filter(|&b| receiver[b]) {
-            pairs.extend((0..n).filter(|&a| role(a, b)).map(|a| (a as u32, b as u32)));
-        }
-    }
-    counters.add("prefilter_us", t.elapsed().as_micros() as u64);
-    counters.add("pairs_with_roles", pairs.len() as u64);
+    let grid = ctx.options.prefilter.then(|| SphereGrid::new(scene, sample, &casters));
+    counters.add("prefilter_grid_us", t.elapsed().as_micros() as u64);
 
-    let t = Instant::now();
+    let per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>)> = receivers
+        .par_iter()
+        .map_init(
+            || (Projector::default(), vec![u32::MAX; n]),
+            |(proj, stamp), &b| {
+                let mut tally = Tally::default();
+                let t = Instant::now();
+                let candidates: Vec<u32> = match &grid {
+                    Some(g) => g.candidates(b, stamp),
+                    None => casters.clone(),
+                };
+                tally.prefilter_ns += t.elapsed().as_nanos() as u64;
+                let t = Instant::now();
+                let mut rings = Vec::new();
+                let plane = scene.polygons[b as usize].plane;
+                let side = light_side(&plane, sample);
+                for a in candidates {
+                    if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
+                        continue;
+                    }
+                    tally.kept += 1;
+                    if scene.verts(a as usize).iter().all(|&v| plane.distance(v) * side <= 0.0) {
+                        tally.behind += 1;
+                    } else if !proj.shadow_polygon(scene, a as usize, b as usize, sample) {
+                        tally.empty += 1;
+                    } else if ctx.view.clip_project(&proj.a, &mut proj.view_scratch, &mut proj.ring) {
+                        rings.push(proj.ring.clone());
+                    }
+                }
+                tally.projection_ns += t.elapsed().as_nanos() as u64;
+                (b, tally, rings)
+            },
+        )
+        .collect();
+
     let mut overlay = Overlay::new(ctx.view.height, ctx.options.keep_outlines);
-    let mut proj = Projector::default();
-    let (mut view_scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
-    let (mut behind, mut zero) = (0u64, 0u64);
-    for (a, b) in pairs {
-        let (a, b) = (a as usize, b as usize);
-        let plane = scene.polygons[b].plane;
-        let side = light_side(&plane, sample);
-        if scene.verts(a).iter().all(|&v| plane.distance(v) * side <= 0.0) {
-            behind += 1;
-            continue;
-        }
-        if proj.shadow_polygon(scene, a, b, sample) {
-            if ctx.view.clip_project(&proj.a, &mut view_scratch, &mut ring) {
-                overlay.add(b as u32, &ring);
-            }
-        } else {
-            zero += 1;
+    let mut total = Tally::default();
+    for (b, tally, rings) in &per_receiver {
+        total.add(tally);
+        for r in rings {
+            overlay.add(*b, r);
         }
     }
     overlay.finish();
-    counters.add("pairs_dropped_behind", behind);
-    counters.add("projections_empty", zero);
+    if ctx.options.prefilter {
+        counters.add("pairs_kept_by_prefilter", total.kept);
+    }
+    counters.add("pairs_dropped_behind", total.behind);
+    counters.add("projections_empty", total.empty);
     counters.add("shadow_polygons", overlay.len() as u64);
-    counters.add("projection_us", t.elapsed().as_micros() as u64);
+    counters.add("prefilter_cpu_us", total.prefilter_ns / 1000);
+    counters.add("projection_cpu_us", total.projection_ns / 1000);
     overlay
+}
+
+/// What happened to one receiver's pairs.
+#[derive(Default)]
+struct Tally {
+    kept: u64,
+    behind: u64,
+    empty: u64,
+    prefilter_ns: u64,
+    projection_ns: u64,
+}
+
+impl Tally {
+    fn add(&mut self, o: &Tally) {
+        self.kept += o.kept;
+        self.behind += o.behind;
+        self.empty += o.empty;
+        self.prefilter_ns += o.prefilter_ns;
+        self.projection_ns += o.projection_ns;
+    }
 }
 
 /// +1 or −1: the sign of `plane.distance` on the light's side of the plane.
@@ -144,9 +180,12 @@ fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> bool {
 /// Scratch space for step 3.
 #[derive(Default)]
 struct Projector {
-    /// The shadow polygon being made.
+    /// The shadow polygon being made, in world space.
     a: Vec<DVec3>,
     b: Vec<DVec3>,
+    view_scratch: [Vec<DVec3>; 2],
+    /// The shadow polygon in screen space.
+    ring: Vec<DVec2>,
 }
 
 impl Projector {
@@ -221,67 +260,93 @@ fn bounding_rectangle(verts: &[DVec3], plane: &Plane) -> [DVec3; 4] {
 /// A polygon's extent as the light sees it.
 #[derive(Debug, Clone, Copy)]
 struct Extent {
-    /// Boxes in the 2D domain of [`sphere_prefilter`] (two when the azimuth wraps).
+    /// Boxes in the 2D domain of the [`SphereGrid`] (two when the azimuth wraps).
     boxes: [Option<[f64; 4]>; 2],
     /// Point lights: the bounding cone's axis and half-angle (π covers everything).
     cone: (DVec3, f64),
 }
 
-/// Step 2: the unordered pairs of polygons whose extents on the sphere around the light
-/// overlap (for a directional light, on the plane across it). Polygons are binned into a
-/// grid over the extent domain (polar angle × azimuth, or the plane's two axes); a pair is
-/// tested once per cell it shares and kept when the exact extents overlap.
-fn sphere_prefilter(scene: &Scene, sample: LightSample) -> Vec<(u32, u32)> {
-    let n = scene.polygons.len();
-    let extents: Vec<Extent> = (0..n).map(|i| extent(scene.verts(i), sample)).collect();
-    // The domain: [0, π] × [−π, π] on the sphere; the bounds of the boxes on the plane.
-    let domain = match sample {
-        LightSample::Point(_) => [0.0, -PI, PI, PI],
-        LightSample::Directional(_) => extents
-            .iter()
-            .flat_map(|e| e.boxes.iter().flatten())
-            .fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |d, b| {
-                [d[0].min(b[0]), d[1].min(b[1]), d[2].max(b[2]), d[3].max(b[3])]
-            }),
-    };
-    let g = ((n as f64).sqrt().ceil() as usize).clamp(4, 1024);
-    let (w, h) = ((domain[2] - domain[0]).max(1e-300), (domain[3] - domain[1]).max(1e-300));
-    let cell = |v: f64, lo: f64, size: f64| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
-    let mut cells: Vec<Vec<u32>> = vec![Vec::new(); g * g];
-    for (i, e) in extents.iter().enumerate() {
-        for b in e.boxes.iter().flatten() {
-            let (c0, c1) = (cell(b[0], domain[0], w), cell(b[2], domain[0], w));
-            let (r0, r1) = (cell(b[1], domain[1], h), cell(b[3], domain[1], h));
-            for c in c0..=c1 {
-                for r in r0..=r1 {
-                    cells[c * g + r].push(i as u32);
-                }
+/// Step 2, the sphere prefilter: every polygon's extent on the sphere around the light (on
+/// the plane across a directional light), and a grid over the extents' domain (polar angle ×
+/// azimuth, or the plane's two axes) in which each caster is binned in every cell its extent
+/// touches.
+struct SphereGrid {
+    extents: Vec<Extent>,
+    domain: [f64; 4],
+    g: usize,
+    cells: Vec<Vec<u32>>,
+    point: bool,
+}
+
+impl SphereGrid {
+    fn new(scene: &Scene, sample: LightSample, casters: &[u32]) -> Self {
+        let n = scene.polygons.len();
+        let extents: Vec<Extent> = (0..n).map(|i| extent(scene.verts(i), sample)).collect();
+        let domain = match sample {
+            LightSample::Point(_) => [0.0, -PI, PI, PI],
+            LightSample::Directional(_) => extents
+                .iter()
+                .flat_map(|e| e.boxes.iter().flatten())
+                .fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |d, b| {
+                    [d[0].min(b[0]), d[1].min(b[1]), d[2].max(b[2]), d[3].max(b[3])]
+                }),
+        };
+        let g = ((casters.len() as f64).sqrt().ceil() as usize).clamp(4, 1024);
+        let mut grid = SphereGrid {
+            extents,
+            domain,
+            g,
+            cells: vec![Vec::new(); g * g],
+            point: matches!(sample, LightSample::Point(_)),
+        };
+        let mut cells = std::mem::take(&mut grid.cells);
+        for &i in casters {
+            for (c, r) in grid.cells_of(i) {
+                cells[c * g + r].push(i);
             }
         }
+        grid.cells = cells;
+        grid
     }
-    let mut pairs: Vec<u64> = Vec::new();
-    for members in &cells {
-        for (k, &i) in members.iter().enumerate() {
-            for &j in &members[k + 1..] {
-                if i != j {
-                    pairs.push(((i.min(j) as u64) << 32) | i.max(j) as u64);
-                }
-            }
-        }
-    }
-    pairs.sort_unstable();
-    pairs.dedup();
-    pairs
-        .into_iter()
-        .map(|p| ((p >> 32) as u32, p as u32))
-        .filter(|&(i, j)| match sample {
-            LightSample::Point(_) => {
-                let (a, b) = (extents[i as usize].cone, extents[j as usize].cone);
-                a.1 + b.1 >= PI || a.0.dot(b.0).clamp(-1.0, 1.0).acos() <= a.1 + b.1
-            }
-            LightSample::Directional(_) => true,
+
+    /// The grid cells (column, row) that polygon `i`'s extent touches.
+    fn cells_of(&self, i: u32) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let d = self.domain;
+        let (w, h) = ((d[2] - d[0]).max(1e-300), (d[3] - d[1]).max(1e-300));
+        let g = self.g;
+        let cell =
+            move |v: f64, lo: f64, size: f64| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
+        self.extents[i as usize].boxes.into_iter().flatten().flat_map(move |b| {
+            let (c0, c1) = (cell(b[0], d[0], w), cell(b[2], d[0], w));
+            let (r0, r1) = (cell(b[1], d[1], h), cell(b[3], d[1], h));
+            (c0..=c1).flat_map(move |c| (r0..=r1).map(move |r| (c, r)))
         })
-        .collect()
+    }
+
+    /// The casters whose extents overlap receiver `b`'s: those sharing a grid cell with it
+    /// whose bounding cones overlap (for a point light; shared cells suffice for a
+    /// directional light, whose boxes are the cells' own test). `stamp` is scratch, one entry
+    /// per polygon, that keeps each caster from being listed twice.
+    fn candidates(&self, b: u32, stamp: &mut [u32]) -> Vec<u32> {
+        let mut out = Vec::new();
+        let (bc, bh) = self.extents[b as usize].cone;
+        for (c, r) in self.cells_of(b) {
+            for &a in &self.cells[c * self.g + r] {
+                if stamp[a as usize] == b {
+                    continue;
+                }
+                stamp[a as usize] = b;
+                let overlap = !self.point || {
+                    let (ac, ah) = self.extents[a as usize].cone;
+                    ah + bh >= PI || ac.dot(bc).clamp(-1.0, 1.0).acos() <= ah + bh
+                };
+                if overlap {
+                    out.push(a);
+                }
+            }
+        }
+        out
+    }
 }
 
 /// A polygon's extent: for a point light, the cone from the light around the directions to

@@ -16,8 +16,8 @@ pub use ray_cast::RayCastShadows;
 use crate::error::{Error, Result};
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
-use crate::view::{ScreenPolygon, View};
-use crate::visibility::Run;
+use crate::view::View;
+use crate::visibility::{FrameRuns, Run};
 
 /// Options of the shadow stages (each stage reads its own).
 #[derive(Debug, Clone, PartialEq)]
@@ -41,10 +41,11 @@ pub struct ShadowContext<'a> {
     pub scene: &'a Scene,
     /// The view.
     pub view: &'a View,
-    /// The scene's polygons in screen space (those the view keeps).
-    pub screen: &'a [ScreenPolygon],
-    /// `on_screen[i]`: whether scene polygon `i` survives clipping (can be seen at all).
-    pub on_screen: Vec<bool>,
+    /// The visible runs of every line.
+    pub runs: &'a FrameRuns,
+    /// `visible[i]`: whether scene polygon `i` is seen at some pixel (the receivers that
+    /// matter).
+    pub visible: Vec<bool>,
     /// Stage options.
     pub options: ShadowOptions,
     /// Each light's samples (`samples[light][sample]`).
@@ -54,15 +55,12 @@ pub struct ShadowContext<'a> {
 }
 
 impl<'a> ShadowContext<'a> {
-    /// The context for rendering `scene` from `view`, whose screen polygons are `screen`.
-    pub fn new(scene: &'a Scene, view: &'a View, screen: &'a [ScreenPolygon], options: ShadowOptions) -> Self {
+    /// The context for rendering `scene` from `view`, whose visible runs are `runs`.
+    pub fn new(scene: &'a Scene, view: &'a View, runs: &'a FrameRuns, options: ShadowOptions) -> Self {
         let samples = scene.lights.iter().map(|l| l.samples()).collect();
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
-        let mut on_screen = vec![false; scene.polygons.len()];
-        for p in screen {
-            on_screen[p.poly as usize] = true;
-        }
-        ShadowContext { scene, view, screen, on_screen, options, samples, extent }
+        let visible = runs.visible(scene.polygons.len());
+        ShadowContext { scene, view, runs, visible, options, samples, extent }
     }
 
     /// Every (light, sample) pair, in order: the flat index of sample `s` of light `l` is

@@ -91,30 +91,59 @@ impl std::fmt::Display for VisibilityMethod {
     }
 }
 
-/// Runs the visibility stage alone over a whole frame: prepares it and walks every line in
-/// parallel bands, as [`crate::render()`] does, handing each band's runs to nobody. Returns
-/// the number of runs and the counters (for benchmarks and studies).
-pub fn resolve_frame(scene: &Scene, method: VisibilityMethod) -> (u64, Counters) {
+/// The visible runs of every line of a frame: what every visibility stage hands on.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct FrameRuns {
+    /// `lines[y]`: the runs of line `y` in increasing x.
+    pub lines: Vec<Vec<Run>>,
+}
+
+impl FrameRuns {
+    /// `visible[i]`: whether scene polygon `i` is seen at some pixel (of `n` polygons).
+    pub fn visible(&self, n: usize) -> Vec<bool> {
+        let mut v = vec![false; n];
+        for r in self.lines.iter().flatten() {
+            v[r.poly as usize] = true;
+        }
+        v
+    }
+
+    /// Number of runs.
+    pub fn count(&self) -> usize {
+        self.lines.iter().map(Vec::len).sum()
+    }
+}
+
+/// Walks every line of a prepared stage in parallel bands and keeps the runs.
+pub fn resolve(vis: &dyn Visibility, height: u32, counters: &mut Counters) -> FrameRuns {
     use rayon::prelude::*;
+    let band = crate::render::band_height(height);
+    let bands: Vec<(Vec<Vec<Run>>, Counters)> = (0..height.div_ceil(band))
+        .into_par_iter()
+        .map(|b| {
+            let mut c = Counters::default();
+            let mut lines = Vec::new();
+            vis.walk(b * band..((b + 1) * band).min(height), &mut c, &mut |_, r| lines.push(r.to_vec()));
+            (lines, c)
+        })
+        .collect();
+    let mut runs = FrameRuns { lines: Vec::with_capacity(height as usize) };
+    for (lines, c) in bands {
+        runs.lines.extend(lines);
+        counters.merge(&c);
+    }
+    counters.add("runs", runs.count() as u64);
+    runs
+}
+
+/// Runs one visibility stage alone over a whole frame of `scene`: projects, prepares and
+/// resolves every line, as [`crate::render()`] does (for benchmarks and studies).
+pub fn resolve_frame(scene: &Scene, method: VisibilityMethod) -> (FrameRuns, Counters) {
     let view = View::new(&scene.camera);
     let screen = view.screen_polygons(scene);
     let mut counters = Counters::default();
     let vis = method.prepare(scene, &view, &screen, &mut counters);
-    let band = crate::render::band_height(view.height);
-    let parts: Vec<(u64, Counters)> = (0..view.height.div_ceil(band))
-        .into_par_iter()
-        .map(|b| {
-            let mut c = Counters::default();
-            let mut runs = 0u64;
-            vis.walk(b * band..((b + 1) * band).min(view.height), &mut c, &mut |_, r| runs += r.len() as u64);
-            (runs, c)
-        })
-        .collect();
-    let mut runs = 0;
-    for (r, c) in parts {
-        runs += r;
-        counters.merge(&c);
-    }
+    let runs = resolve(&*vis, view.height, &mut counters);
     (runs, counters)
 }
 
