@@ -33,8 +33,8 @@
 //! light; zero-area projections are dropped. None of these divide by zero.
 
 use super::overlay::{Interval, Overlay, OverlayWalker};
+use super::projection::{bounding_rectangle, edge_on, light_side, Projector};
 use super::{ShadowContext, ShadowStage, ShadowWalker};
-use crate::geometry::{clip_polygon, newell_normal, Plane};
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -83,8 +83,8 @@ fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Coun
     let per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>)> = receivers
         .par_iter()
         .map_init(
-            || (Projector::default(), vec![u32::MAX; n]),
-            |(proj, stamp), &b| {
+            || (Projector::default(), vec![u32::MAX; n], [Vec::new(), Vec::new()], Vec::new()),
+            |(proj, stamp, scratch, ring), &b| {
                 let mut tally = Tally::default();
                 let t = Instant::now();
                 let candidates: Vec<u32> = match &grid {
@@ -96,6 +96,7 @@ fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Coun
                 let mut rings = Vec::new();
                 let plane = scene.polygons[b as usize].plane;
                 let side = light_side(&plane, sample);
+                let rect = bounding_rectangle(scene.verts(b as usize), &plane);
                 for a in candidates {
                     if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
                         continue;
@@ -103,10 +104,10 @@ fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Coun
                     tally.kept += 1;
                     if scene.verts(a as usize).iter().all(|&v| plane.distance(v) * side <= 0.0) {
                         tally.behind += 1;
-                    } else if !proj.shadow_polygon(scene, a as usize, b as usize, sample) {
+                    } else if !proj.project(scene.verts(a as usize), &plane, &rect, sample) {
                         tally.empty += 1;
-                    } else if ctx.view.clip_project(&proj.a, &mut proj.view_scratch, &mut proj.ring) {
-                        rings.push(proj.ring.clone());
+                    } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
+                        rings.push(ring.clone());
                     }
                 }
                 tally.projection_ns += t.elapsed().as_nanos() as u64;
@@ -153,108 +154,6 @@ impl Tally {
         self.prefilter_ns += o.prefilter_ns;
         self.projection_ns += o.projection_ns;
     }
-}
-
-/// +1 or −1: the sign of `plane.distance` on the light's side of the plane.
-fn light_side(plane: &Plane, sample: LightSample) -> f64 {
-    let d = match sample {
-        LightSample::Point(s) => plane.distance(s),
-        LightSample::Directional(dir) => -plane.n.dot(dir),
-    };
-    if d >= 0.0 {
-        1.0
-    } else {
-        -1.0
-    }
-}
-
-/// Whether the light lies in polygon `i`'s plane (to a relative 1e-12): its shadow has no area.
-fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> bool {
-    let plane = &scene.polygons[i].plane;
-    match sample {
-        LightSample::Point(s) => plane.distance(s).abs() <= 1e-12 * extent,
-        LightSample::Directional(d) => plane.n.dot(d).abs() <= 1e-12,
-    }
-}
-
-/// Scratch space for step 3.
-#[derive(Default)]
-struct Projector {
-    /// The shadow polygon being made, in world space.
-    a: Vec<DVec3>,
-    b: Vec<DVec3>,
-    view_scratch: [Vec<DVec3>; 2],
-    /// The shadow polygon in screen space.
-    ring: Vec<DVec2>,
-}
-
-impl Projector {
-    /// Step 3: the shadow of polygon `a` on the plane of polygon `b`, into `self.a` in world
-    /// space; `false` when nothing of `a` lies between the light and `b` within `b`'s bounds,
-    /// or the projection has no area.
-    fn shadow_polygon(&mut self, scene: &Scene, a: usize, b: usize, sample: LightSample) -> bool {
-        let plane = scene.polygons[b].plane;
-        let side = light_side(&plane, sample);
-        self.a.clear();
-        self.a.extend_from_slice(scene.verts(a));
-        // The part of A on the light's side of B's plane ...
-        self.clip(|x| plane.distance(x) * side);
-        // ... and, for a point light, on B's side of the plane through the light parallel to B.
-        if let LightSample::Point(s) = sample {
-            let ds = plane.distance(s);
-            self.clip(|x| (ds - plane.distance(x)) * side);
-        }
-        // ... within the pyramid (prism, for a directional light) from the light over B's
-        // bounding rectangle.
-        let rect = bounding_rectangle(scene.verts(b), &plane);
-        let center = rect.iter().sum::<DVec3>() / 4.0;
-        for k in 0..4 {
-            let (q0, q1) = (rect[k], rect[(k + 1) % 4]);
-            let (origin, m) = match sample {
-                LightSample::Point(s) => (s, (q0 - s).cross(q1 - s)),
-                LightSample::Directional(d) => (q0, (q1 - q0).cross(d)),
-            };
-            let m = if m.dot(center - origin) >= 0.0 { m } else { -m };
-            self.clip(|x| m.dot(x - origin));
-        }
-        if self.a.is_empty() {
-            return false;
-        }
-        // Project onto B's plane from the light.
-        for x in &mut self.a {
-            *x = match sample {
-                LightSample::Point(s) => s + (*x - s) * (-plane.distance(s) / plane.n.dot(*x - s)),
-                LightSample::Directional(d) => *x - d * (plane.distance(*x) / plane.n.dot(d)),
-            };
-        }
-        let area2 = newell_normal(&self.a).length();
-        let size = rect[0].distance(rect[2]);
-        area2 > 1e-12 * size * size && self.a.iter().all(|x| x.is_finite())
-    }
-
-    fn clip(&mut self, dist: impl Fn(DVec3) -> f64) {
-        if !self.a.is_empty() && self.a.iter().any(|&x| dist(x) < 0.0) {
-            clip_polygon(&self.a, dist, &mut self.b);
-            std::mem::swap(&mut self.a, &mut self.b);
-        }
-    }
-}
-
-/// The corners of the smallest rectangle in `plane` around `verts` (axes: any pair of unit
-/// vectors across the normal), grown by a relative 1e-9 so B's own edges are inside.
-fn bounding_rectangle(verts: &[DVec3], plane: &Plane) -> [DVec3; 4] {
-    let u = plane.n.any_orthonormal_vector();
-    let v = plane.n.cross(u);
-    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-    for p in verts {
-        let q = DVec2::new(p.dot(u), p.dot(v));
-        lo = lo.min(q);
-        hi = hi.max(q);
-    }
-    let grow = (hi - lo).max_element() * 1e-9;
-    let (lo, hi) = (lo - grow, hi + grow);
-    let o = -plane.d * plane.n;
-    [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].map(|c| o + c.x * u + c.y * v)
 }
 
 /// A polygon's extent as the light sees it.

@@ -8,6 +8,7 @@
 
 mod bouknight_kelley;
 mod overlay;
+mod projection;
 mod ray_cast;
 
 pub use bouknight_kelley::BouknightKelley;

@@ -1,0 +1,107 @@
+//! Shadow projection: a polygon projected from a light sample onto a plane (seed 003's
+//! `Q = L − (P − L)(N·L + d)/(N·(P − L))`; for a directional light the parallel projection of
+//! seed 004's `M_par`), clipped so that only what lies between the light and the plane is
+//! projected and the result stays within a rectangle of the plane. Bouknight-Kelley projects
+//! onto each receiver; Crow projects onto the near plane for the eye's count.
+
+use crate::geometry::{clip_polygon, newell_normal, Plane};
+use crate::scene::{LightSample, Scene};
+use glam::{DVec2, DVec3};
+
+/// +1 or −1: the sign of `plane.distance` on the light's side of the plane.
+pub fn light_side(plane: &Plane, sample: LightSample) -> f64 {
+    let d = match sample {
+        LightSample::Point(s) => plane.distance(s),
+        LightSample::Directional(dir) => -plane.n.dot(dir),
+    };
+    if d >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// Whether the light lies in polygon `i`'s plane (to a relative 1e-12): its shadow has no area.
+pub fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> bool {
+    let plane = &scene.polygons[i].plane;
+    match sample {
+        LightSample::Point(s) => plane.distance(s).abs() <= 1e-12 * extent,
+        LightSample::Directional(d) => plane.n.dot(d).abs() <= 1e-12,
+    }
+}
+
+/// Projects polygons from a light sample onto a bounded piece of a plane, keeping the scratch
+/// space between calls.
+#[derive(Debug, Default)]
+pub struct Projector {
+    /// The last shadow made, in world space.
+    pub shadow: Vec<DVec3>,
+    scratch: Vec<DVec3>,
+}
+
+impl Projector {
+    /// The shadow of polygon `verts` on `plane`, within the rectangle `rect` of that plane,
+    /// into `self.shadow` (world space). Only the part of the polygon between the light and
+    /// the plane can cast it: the polygon is clipped by the plane (keeping the light's side),
+    /// for a point light by the plane through the light parallel to it, and by the pyramid
+    /// (a prism for a directional light) from the light over `rect`, which keeps the
+    /// projection finite; then projected from the light onto the plane. `false` when nothing
+    /// is left or the shadow has no area.
+    pub fn project(&mut self, verts: &[DVec3], plane: &Plane, rect: &[DVec3; 4], sample: LightSample) -> bool {
+        let side = light_side(plane, sample);
+        self.shadow.clear();
+        self.shadow.extend_from_slice(verts);
+        self.clip(|x| plane.distance(x) * side);
+        if let LightSample::Point(s) = sample {
+            let ds = plane.distance(s);
+            self.clip(|x| (ds - plane.distance(x)) * side);
+        }
+        let center = rect.iter().sum::<DVec3>() / 4.0;
+        for k in 0..4 {
+            let (q0, q1) = (rect[k], rect[(k + 1) % 4]);
+            let (origin, m) = match sample {
+                LightSample::Point(s) => (s, (q0 - s).cross(q1 - s)),
+                LightSample::Directional(d) => (q0, (q1 - q0).cross(d)),
+            };
+            let m = if m.dot(center - origin) >= 0.0 { m } else { -m };
+            self.clip(|x| m.dot(x - origin));
+        }
+        if self.shadow.is_empty() {
+            return false;
+        }
+        for x in &mut self.shadow {
+            *x = match sample {
+                LightSample::Point(s) => s + (*x - s) * (-plane.distance(s) / plane.n.dot(*x - s)),
+                LightSample::Directional(d) => *x - d * (plane.distance(*x) / plane.n.dot(d)),
+            };
+        }
+        let area2 = newell_normal(&self.shadow).length();
+        let size = rect[0].distance(rect[2]);
+        area2 > 1e-12 * size * size && self.shadow.iter().all(|x| x.is_finite())
+    }
+
+    fn clip(&mut self, dist: impl Fn(DVec3) -> f64) {
+        if !self.shadow.is_empty() && self.shadow.iter().any(|&x| dist(x) < 0.0) {
+            clip_polygon(&self.shadow, dist, &mut self.scratch);
+            std::mem::swap(&mut self.shadow, &mut self.scratch);
+        }
+    }
+}
+
+/// The corners of the smallest rectangle in `plane` around `verts` (axes: any pair of unit
+/// vectors across the normal), grown by a relative 1e-9 so the polygon's own edges are inside.
+pub fn bounding_rectangle(verts: &[DVec3], plane: &Plane) -> [DVec3; 4] {
+    let u = plane.n.any_orthonormal_vector();
+    let v = plane.n.cross(u);
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    for p in verts {
+        let q = DVec2::new(p.dot(u), p.dot(v));
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    let grow = (hi - lo).max_element() * 1e-9;
+    let (lo, hi) = (lo - grow, hi + grow);
+    let o = -plane.d * plane.n;
+    [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].map(|c| o + c.x * u + c.y * v)
+}
+
