@@ -104,10 +104,14 @@ pub fn classify_face(verts: &[DVec3]) -> FaceShape {
     FaceShape::Fan(fan)
 }
 
-/// Clips a polygon (convex or not) to the half-space `dist(p) >= 0` (Sutherland-Hodgman).
-/// A concave polygon may come back with coincident "bridge" edges along the plane; the
-/// even-odd rule cancels them. Fewer than three vertices means nothing is left.
-pub fn clip_polygon(poly: &[DVec3], dist: impl Fn(DVec3) -> f64, out: &mut Vec<DVec3>) {
+/// Clips a polygon (convex or not) to the half-space `dist(p) >= 0` (Sutherland-Hodgman),
+/// in 3D or, with `DVec4`, in homogeneous coordinates. A concave polygon may come back with
+/// coincident "bridge" edges along the plane; the even-odd rule cancels them. Fewer than
+/// three vertices means nothing is left.
+pub fn clip_polygon<T>(poly: &[T], dist: impl Fn(T) -> f64, out: &mut Vec<T>)
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Mul<f64, Output = T>,
+{
     out.clear();
     let Some(&last) = poly.last() else { return };
     let mut prev = last;

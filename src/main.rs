@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use umbra::shadow::volumes::Counting;
 use umbra::shadow::ShadowOptions;
 use umbra::{generate, render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
@@ -35,8 +36,9 @@ struct RenderArgs {
     /// Hidden-surface stage: scanline (Watkins), zbuffer, or ray-cast (one ray per pixel).
     #[arg(long, default_value = "scanline", value_parser = parse_visibility)]
     visibility: VisibilityMethod,
-    /// Shadow stage: none, bouknight-kelley (projected shadow polygons, exact), or ray-cast
-    /// (exact per-pixel reference); the default is the engine's recommended exact method.
+    /// Shadow stage: none, bouknight-kelley (projected shadow polygons), crow (shadow volumes
+    /// counted per span), or ray-cast (per-pixel reference); all but none are exact. The
+    /// default is the engine's recommended exact method.
     #[arg(long, default_value = ShadowMethod::DEFAULT.name(), value_parser = parse_shadows)]
     shadows: ShadowMethod,
     /// Write the analysis buffers id.png and light<k>.png into this folder.
@@ -51,6 +53,10 @@ struct RenderArgs {
     /// Bouknight-Kelley: project every pair, without the sphere prefilter (to measure it).
     #[arg(long)]
     no_prefilter: bool,
+    /// Crow: count shadow volumes from the eye with the eye's own count (zpass), from
+    /// infinity (zfail), or from zero at the eye (naive-zpass, wrong when the eye is in shadow).
+    #[arg(long, default_value = "zpass", value_parser = parse_count)]
+    crow_count: Counting,
     /// Draw the shadow stage's own polygons for the first light sample over the image
     /// (shadow-polygons: Bouknight-Kelley's projections on their receivers).
     #[arg(long, value_enum)]
@@ -107,6 +113,10 @@ fn parse_visibility(s: &str) -> Result<VisibilityMethod, String> {
     s.parse().map_err(|e: umbra::Error| e.to_string())
 }
 
+fn parse_count(s: &str) -> Result<Counting, String> {
+    s.parse().map_err(|e: umbra::Error| e.to_string())
+}
+
 fn parse_shadows(s: &str) -> Result<ShadowMethod, String> {
     s.parse().map_err(|e: umbra::Error| e.to_string())
 }
@@ -115,7 +125,11 @@ fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
             let scene = Scene::load(&a.scene)?;
-            let shadow_options = ShadowOptions { prefilter: !a.no_prefilter, keep_outlines: a.debug.is_some() };
+            let shadow_options = ShadowOptions {
+                prefilter: !a.no_prefilter,
+                crow_count: a.crow_count,
+                keep_outlines: a.debug.is_some(),
+            };
             let opts = RenderOptions { visibility: a.visibility, shadows: a.shadows, shadow_options, progress: true };
             let out = render(&scene, &opts)?;
             let mut img = out.frame.color_image(a.gamma);

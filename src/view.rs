@@ -8,7 +8,7 @@
 
 use crate::geometry::{clip_polygon, Plane};
 use crate::scene::{Camera, Scene};
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, DVec4};
 
 /// Camera basis and projection.
 #[derive(Debug, Clone, Copy)]
@@ -139,6 +139,70 @@ impl View {
     /// Clips a world polygon to `near <= z (<= far)` in camera space and projects it.
     /// Returns `false` (and leaves `out` empty) when nothing is left.
     pub fn clip_project(&self, verts: &[DVec3], scratch: &mut [Vec<DVec3>; 2], out: &mut Vec<DVec2>) -> bool {
+        self.clip_project_to(verts, self.far, scratch, out)
+    }
+
+    /// As [`View::clip_project`], clipping by the near plane only (shadow-volume polygons must
+    /// not be cut by the far plane: that is what makes z-fail fail).
+    pub fn clip_project_near(&self, verts: &[DVec3], scratch: &mut [Vec<DVec3>; 2], out: &mut Vec<DVec2>) -> bool {
+        self.clip_project_to(verts, None, scratch, out)
+    }
+
+    /// Clips a polygon given in homogeneous world coordinates (`w = 0` for points at infinity,
+    /// as shadow volumes extruded to infinity have) to the near plane and to a guard band
+    /// 10⁴ times wider than the view, then projects it. The guard band keeps every point in
+    /// front of the eye, so vanishing points project to finite (far off-screen) positions.
+    pub fn clip_project_homogeneous(
+        &self,
+        verts: &[DVec4],
+        scratch: &mut [Vec<DVec4>; 2],
+        out: &mut Vec<DVec2>,
+    ) -> bool {
+        out.clear();
+        let [a, b] = scratch;
+        a.clear();
+        a.extend(verts.iter().map(|h| {
+            let v = h.truncate() - self.eye * h.w;
+            DVec4::new(v.dot(self.r), v.dot(self.u), v.dot(self.f), h.w)
+        }));
+        let g = 1e4 * (self.t * self.aspect).max(self.t);
+        let near = self.near;
+        let planes: [&dyn Fn(DVec4) -> f64; 5] = [
+            &|c: DVec4| c.z - near * c.w,
+            &|c: DVec4| g * c.z - c.x,
+            &|c: DVec4| g * c.z + c.x,
+            &|c: DVec4| g * c.z - c.y,
+            &|c: DVec4| g * c.z + c.y,
+        ];
+        for plane in planes {
+            if a.iter().any(|&c| plane(c) < 0.0) {
+                clip_polygon(a, plane, b);
+                std::mem::swap(a, b);
+            }
+        }
+        if a.len() < 3 {
+            return false;
+        }
+        out.extend(a.iter().map(|c| self.project(c.truncate())));
+        out.iter().all(|p| p.is_finite())
+    }
+
+    /// The near plane (normal along the view direction) and the corners of the part of it
+    /// the image sees, grown by 1% so pixel centres at the border are inside.
+    pub fn near_rectangle(&self) -> (Plane, [DVec3; 4]) {
+        let c = self.eye + self.f * self.near;
+        let (hx, hy) = (self.near * self.t * self.aspect * 1.01, self.near * self.t * 1.01);
+        let corner = |sx: f64, sy: f64| c + self.r * (sx * hx) + self.u * (sy * hy);
+        (Plane::new(self.f, c), [corner(-1.0, -1.0), corner(1.0, -1.0), corner(1.0, 1.0), corner(-1.0, 1.0)])
+    }
+
+    fn clip_project_to(
+        &self,
+        verts: &[DVec3],
+        far: Option<f64>,
+        scratch: &mut [Vec<DVec3>; 2],
+        out: &mut Vec<DVec2>,
+    ) -> bool {
         out.clear();
         let [a, b] = scratch;
         a.clear();
@@ -147,7 +211,7 @@ impl View {
             clip_polygon(a, |c| c.z - self.near, b);
             std::mem::swap(a, b);
         }
-        if let Some(far) = self.far {
+        if let Some(far) = far {
             if a.iter().any(|c| c.z > far) {
                 clip_polygon(a, |c| far - c.z, b);
                 std::mem::swap(a, b);

@@ -7,11 +7,14 @@
 //! pipeline, before any stage is asked; stages only answer for runs the rule leaves lit.
 
 mod bouknight_kelley;
+mod crow;
 mod overlay;
 mod projection;
 mod ray_cast;
+pub mod volumes;
 
 pub use bouknight_kelley::BouknightKelley;
+pub use crow::Crow;
 pub use ray_cast::RayCastShadows;
 
 use crate::error::{Error, Result};
@@ -25,6 +28,8 @@ use crate::visibility::{FrameRuns, Run};
 pub struct ShadowOptions {
     /// Bouknight-Kelley: use the sphere prefilter (default true).
     pub prefilter: bool,
+    /// Crow: how the shadow volumes are counted along the line of sight (default z-pass).
+    pub crow_count: volumes::Counting,
     /// Keep the screen outlines of the stage's polygons (shadow polygons, detail polygons)
     /// for drawing them over the image.
     pub keep_outlines: bool,
@@ -32,7 +37,7 @@ pub struct ShadowOptions {
 
 impl Default for ShadowOptions {
     fn default() -> Self {
-        ShadowOptions { prefilter: true, keep_outlines: false }
+        ShadowOptions { prefilter: true, crow_count: volumes::Counting::ZPass, keep_outlines: false }
     }
 }
 
@@ -112,6 +117,8 @@ pub enum ShadowMethod {
     RayCast,
     /// Appel / Bouknight-Kelley projected shadow polygons, scan segment by scan segment.
     BouknightKelley,
+    /// Crow's shadow volumes counted per span.
+    Crow,
 }
 
 impl ShadowMethod {
@@ -119,7 +126,8 @@ impl ShadowMethod {
     pub const DEFAULT: ShadowMethod = ShadowMethod::RayCast;
 
     /// Every method.
-    pub const ALL: [ShadowMethod; 3] = [ShadowMethod::None, ShadowMethod::BouknightKelley, ShadowMethod::RayCast];
+    pub const ALL: [ShadowMethod; 4] =
+        [ShadowMethod::None, ShadowMethod::BouknightKelley, ShadowMethod::Crow, ShadowMethod::RayCast];
 
     /// The method's name on the command line.
     pub fn name(self) -> &'static str {
@@ -127,6 +135,7 @@ impl ShadowMethod {
             ShadowMethod::None => "none",
             ShadowMethod::RayCast => "ray-cast",
             ShadowMethod::BouknightKelley => "bouknight-kelley",
+            ShadowMethod::Crow => "crow",
         }
     }
 
@@ -141,6 +150,7 @@ impl ShadowMethod {
             ShadowMethod::None => Box::new(NoShadows),
             ShadowMethod::RayCast => Box::new(RayCastShadows::new(ctx, counters)),
             ShadowMethod::BouknightKelley => Box::new(BouknightKelley::new(ctx, counters)),
+            ShadowMethod::Crow => Box::new(Crow::new(ctx, counters)),
         })
     }
 }

@@ -104,4 +104,3 @@ pub fn bounding_rectangle(verts: &[DVec3], plane: &Plane) -> [DVec3; 4] {
     let o = -plane.d * plane.n;
     [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].map(|c| o + c.x * u + c.y * v)
 }
-

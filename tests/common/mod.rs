@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use std::path::PathBuf;
+use umbra::shadow::ShadowOptions;
 use umbra::{render, Frame, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 /// Every scene file in `scenes/`.
@@ -29,8 +30,33 @@ pub fn load_scaled(path: &PathBuf, max_width: u32) -> Scene {
 }
 
 pub fn frame(scene: &Scene, visibility: VisibilityMethod, shadows: ShadowMethod) -> Frame {
-    let opts = RenderOptions { visibility, shadows, ..Default::default() };
+    frame_with(scene, visibility, shadows, ShadowOptions::default())
+}
+
+pub fn frame_with(
+    scene: &Scene,
+    visibility: VisibilityMethod,
+    shadows: ShadowMethod,
+    shadow_options: ShadowOptions,
+) -> Frame {
+    let opts = RenderOptions { visibility, shadows, shadow_options, ..Default::default() };
     render(scene, &opts).unwrap_or_else(|e| panic!("{e}")).frame
+}
+
+/// The exact scanline-family stages, with the options that make them exact.
+pub fn exact_stages() -> Vec<(String, ShadowMethod, ShadowOptions)> {
+    use umbra::shadow::volumes::Counting;
+    let d = ShadowOptions::default;
+    vec![
+        ("bouknight-kelley".into(), ShadowMethod::BouknightKelley, d()),
+        (
+            "bouknight-kelley --no-prefilter".into(),
+            ShadowMethod::BouknightKelley,
+            ShadowOptions { prefilter: false, ..d() },
+        ),
+        ("crow zpass".into(), ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZPass, ..d() }),
+        ("crow zfail".into(), ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZFail, ..d() }),
+    ]
 }
 
 /// Asserts that `got` sees the same face as `reference` at every pixel whose 3x3

@@ -1,0 +1,304 @@
+//! Crow's shadow volumes (F. C. Crow, "Shadow algorithms for computer graphics", SIGGRAPH
+//! 1977), counted per span as a scanline renderer does it.
+//!
+//! The shadow polygons that bound each light sample's volumes ([`super::volumes`]) are put
+//! into screen space and walked along the scanlines with the shared edge and active-edge
+//! tables as invisible surfaces. Crow's rule: along the line of sight, +1 for a shadow polygon
+//! facing the viewer, −1 for one facing away; a point is in shadow when the count is above
+//! zero.
+//!
+//! For a visible run on polygon B, the count can change only at an *event*: where a shadow
+//! polygon's edge crosses the scanline (it starts or stops covering the run), or where a
+//! shadow polygon's plane crosses B's plane (it passes from in front of the visible surface
+//! to behind it; both inverse depths are linear along the line, so the crossing is found
+//! exactly). The run is split at its events and the count taken once per piece.
+//!
+//! - **z-pass**: the shadow polygons between the eye and the visible point, starting from
+//!   the eye's own count — the near caps put that in, pixel by pixel, as polygons at the near
+//!   plane that every visible point lies behind.
+//! - **z-fail**: the shadow polygons behind the visible point, signs reversed (counting from
+//!   infinity toward the eye), with the volumes capped.
+//! - **naive z-pass**: z-pass from zero. Wrong wherever the near plane is inside a volume
+//!   (seed 000's failure), on purpose.
+//!
+//! A front cap that is the visible polygon itself lies exactly at the visible point: z-pass
+//! takes it as not in front, z-fail as behind, as a depth test `<` would. A per-polygon
+//! volume never counts for its own face.
+
+use super::volumes::{shadow_polygons, Adjacency, Counting, Part};
+use super::{ShadowContext, ShadowStage, ShadowWalker};
+use crate::scan::{boundary, ActiveEdges, EdgeTable};
+use crate::stats::Counters;
+use crate::view::DepthPlane;
+use crate::visibility::Run;
+use glam::DVec2;
+
+const NONE: u32 = u32::MAX;
+
+/// A shadow polygon in screen space.
+#[derive(Debug, Clone, Copy)]
+struct Screened {
+    depth: DepthPlane,
+    /// +1 when the eye sees its outward side.
+    sign: i32,
+    near_cap: bool,
+    lies_on: u32,
+    owner_face: u32,
+}
+
+/// One light sample's shadow polygons, ready to walk.
+struct SampleVolumes {
+    table: EdgeTable,
+    polys: Vec<Screened>,
+    rings: Vec<Vec<DVec2>>,
+}
+
+/// The prepared stage.
+pub struct Crow<'a> {
+    ctx: &'a ShadowContext<'a>,
+    counting: Counting,
+    samples: Vec<SampleVolumes>,
+}
+
+impl<'a> Crow<'a> {
+    /// Builds every light sample's shadow polygons and their edge tables.
+    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
+        let counting = ctx.options.crow_count;
+        let view = ctx.view;
+        let adjacency = Adjacency::new(ctx.scene);
+        let samples = ctx
+            .all_samples()
+            .map(|(_, _, sample)| {
+                let mut table = EdgeTable::new(view.height);
+                let mut polys = Vec::new();
+                let mut rings = Vec::new();
+                let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
+                for sp in shadow_polygons(ctx, &adjacency, sample, counting, counters) {
+                    // A back cap lies on the plane at infinity: inverse depth 0, behind all.
+                    let depth = match &sp.plane {
+                        Some(plane) => match view.depth_plane(plane) {
+                            Some(d) => d,
+                            None => continue, // edge-on to the eye
+                        },
+                        None => DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
+                    };
+                    if sp.part == Part::NearCap {
+                        // On the near plane by construction: projected as it is (clipping
+                        // it there would let rounding throw it away).
+                        ring.clear();
+                        ring.extend(sp.verts.iter().map(|&v| view.project(view.to_camera(v.truncate()))));
+                    } else if !view.clip_project_homogeneous(&sp.verts, &mut scratch, &mut ring) {
+                        continue;
+                    }
+                    table.add_ring(polys.len() as u32, &ring);
+                    polys.push(Screened {
+                        depth,
+                        sign: sp.sign,
+                        near_cap: sp.part == Part::NearCap,
+                        lies_on: sp.lies_on.unwrap_or(NONE),
+                        owner_face: sp.owner_face.unwrap_or(NONE),
+                    });
+                    if ctx.options.keep_outlines {
+                        rings.push(ring.clone());
+                    }
+                }
+                table.finish();
+                counters.add("screen_shadow_polygons", polys.len() as u64);
+                SampleVolumes { table, polys, rings }
+            })
+            .collect();
+        Crow { ctx, counting, samples }
+    }
+}
+
+impl ShadowStage for Crow<'_> {
+    fn walker(&self) -> Box<dyn ShadowWalker + '_> {
+        let h = self.ctx.view.height;
+        Box::new(Walker {
+            stage: self,
+            lines: self
+                .samples
+                .iter()
+                .map(|s| LineState {
+                    aet: ActiveEdges::new(&s.table, 0..h),
+                    xs: Vec::new(),
+                    cursor: 0,
+                    open: vec![NONE; s.polys.len()],
+                    open_list: Vec::new(),
+                })
+                .collect(),
+            events: Vec::new(),
+            yc: 0.0,
+            runs: 0,
+            events_total: 0,
+            split: 0,
+        })
+    }
+
+    fn outlines(&self) -> Vec<Vec<DVec2>> {
+        self.samples.first().map_or_else(Vec::new, |s| s.rings.clone())
+    }
+}
+
+/// One sample's walk along the current line: its crossings as (first pixel, polygon), and
+/// which polygons cover the pixel the walk has reached.
+struct LineState<'a> {
+    aet: ActiveEdges<'a>,
+    xs: Vec<(u32, u32)>,
+    cursor: usize,
+    /// `open[t]`: where polygon t started covering (its slot in `open_list`), or NONE.
+    open: Vec<u32>,
+    open_list: Vec<(u32, u32)>,
+}
+
+impl LineState<'_> {
+    fn toggle(&mut self, tag: u32, at: u32, mut closed: impl FnMut(u32, u32, u32)) {
+        let slot = self.open[tag as usize];
+        if slot == NONE {
+            self.open[tag as usize] = self.open_list.len() as u32;
+            self.open_list.push((tag, at));
+        } else {
+            let (_, start) = self.open_list.swap_remove(slot as usize);
+            if let Some(&(moved, _)) = self.open_list.get(slot as usize) {
+                self.open[moved as usize] = slot;
+            }
+            self.open[tag as usize] = NONE;
+            closed(tag, start, at);
+        }
+    }
+}
+
+struct Walker<'s> {
+    stage: &'s Crow<'s>,
+    lines: Vec<LineState<'s>>,
+    events: Vec<(u32, i32)>,
+    yc: f64,
+    runs: u64,
+    events_total: u64,
+    split: u64,
+}
+
+impl ShadowWalker for Walker<'_> {
+    fn start_line(&mut self, line: u32) {
+        self.yc = line as f64 + 0.5;
+        let width = self.stage.ctx.view.width;
+        for st in &mut self.lines {
+            let xs = st.aet.advance_to(line);
+            st.xs.clear();
+            st.xs.extend(xs.iter().map(|c| (boundary(c.x, width), c.tag)));
+            st.cursor = 0;
+            for &(t, _) in &st.open_list {
+                st.open[t as usize] = NONE;
+            }
+            st.open_list.clear();
+        }
+    }
+
+    fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
+        let k = self.stage.ctx.sample_index(light, sample);
+        let polys = &self.stage.samples[k].polys;
+        let scene = self.stage.ctx.scene;
+        let b = run.poly;
+        let face = scene.polygons[b as usize].face;
+        let Some(bd) = self.stage.ctx.view.depth_plane(&scene.polygons[b as usize].plane) else {
+            lit.fill(1.0);
+            return;
+        };
+        let (counting, yc) = (self.stage.counting, self.yc);
+        let st = &mut self.lines[k];
+        // Bring the walk to the run's first pixel: the open polygons then cover it.
+        while st.cursor < st.xs.len() && st.xs[st.cursor].0 <= run.x0 {
+            let (_, t) = st.xs[st.cursor];
+            st.toggle(t, run.x0, |_, _, _| {});
+            st.cursor += 1;
+        }
+        // Pieces of coverage within the run: (polygon, first pixel, end).
+        for o in &mut st.open_list {
+            o.1 = run.x0;
+        }
+        let mut pieces: Vec<(u32, u32, u32)> = Vec::new();
+        while st.cursor < st.xs.len() && st.xs[st.cursor].0 < run.x1 {
+            let (at, t) = st.xs[st.cursor];
+            st.toggle(t, at, |t, s, e| pieces.push((t, s, e)));
+            st.cursor += 1;
+        }
+        for &(t, s) in &st.open_list {
+            pieces.push((t, s, run.x1));
+        }
+        // Events: where each covering polygon starts and stops counting.
+        self.events.clear();
+        for (t, s, e) in pieces {
+            if s >= e {
+                continue;
+            }
+            let p = &polys[t as usize];
+            if p.owner_face == face {
+                continue;
+            }
+            // Whether polygon p counts at pixel x: in front of the visible point for z-pass,
+            // behind it (ties on the visible polygon included) for z-fail.
+            let counts = |x: u32| {
+                let in_front =
+                    p.near_cap || (p.lies_on != b && p.depth.inv_z(x as f64 + 0.5, yc) > bd.inv_z(x as f64 + 0.5, yc));
+                match counting {
+                    Counting::ZFail => !in_front,
+                    _ => in_front,
+                }
+            };
+            let sign = if counting == Counting::ZFail { -p.sign } else { p.sign };
+            let (first, last) = (counts(s), counts(e - 1));
+            let mut add = |a: u32, z: u32| {
+                if a < z {
+                    self.events.push((a, sign));
+                    self.events.push((z, -sign));
+                }
+            };
+            if first == last {
+                if first {
+                    add(s, e);
+                }
+                continue;
+            }
+            // The planes cross inside [s, e): find the first pixel that counts differently.
+            let (l, r) = (p.depth, bd);
+            let x_star = ((r.b - l.b) * yc + (r.c - l.c)) / (l.a - r.a);
+            let mut m = if x_star.is_finite() { boundary(x_star, u32::MAX).clamp(s + 1, e - 1) } else { s + 1 };
+            while m > s + 1 && counts(m - 1) != first {
+                m -= 1;
+            }
+            while m < e - 1 && counts(m) == first {
+                m += 1;
+            }
+            if first {
+                add(s, m);
+            } else {
+                add(m, e);
+            }
+        }
+        // Sweep: the count is constant between events.
+        self.events.sort_unstable_by_key(|e| e.0);
+        self.runs += 1;
+        self.events_total += self.events.len() as u64;
+        let (mut count, mut x, mut pieces_made) = (0i32, run.x0, 0);
+        let mut i = 0;
+        while x < run.x1 {
+            while i < self.events.len() && self.events[i].0 <= x {
+                count += self.events[i].1;
+                i += 1;
+            }
+            let next = self.events.get(i).map_or(run.x1, |e| e.0.min(run.x1));
+            lit[(x - run.x0) as usize..(next - run.x0) as usize].fill(if count > 0 { 0.0 } else { 1.0 });
+            pieces_made += 1;
+            x = next;
+        }
+        if pieces_made > 1 {
+            self.split += 1;
+        }
+    }
+
+    fn finish(&mut self, counters: &mut Counters) {
+        counters.add("runs_counted", self.runs);
+        counters.add("events", self.events_total);
+        counters.add("runs_split", self.split);
+    }
+}
