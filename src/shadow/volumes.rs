@@ -255,8 +255,11 @@ pub struct Adjacency {
     /// object (every edge shared by exactly two of its polygons, running opposite ways, no
     /// face split into a fan) each edge once as `(p, q, a, b)`: it runs `a -> b` in polygon
     /// `p` and `b -> a` in `q`.
-    objects: Vec<(Vec<usize>, Option<Vec<(usize, usize, DVec3, DVec3)>>)>,
+    objects: Vec<(Vec<usize>, Option<Vec<Edge>>)>,
 }
+
+/// An edge of a closed object: it runs `a -> b` in polygon `p` and `b -> a` in polygon `q`.
+type Edge = (usize, usize, DVec3, DVec3);
 
 impl Adjacency {
     /// The adjacency of the scene's shadow-casting polygons, by object. Vertices are welded
@@ -300,7 +303,7 @@ impl Adjacency {
     }
 }
 
-fn closed_edges(scene: &crate::Scene, polys: &[usize], id: &[u32]) -> Option<Vec<(usize, usize, DVec3, DVec3)>> {
+fn closed_edges(scene: &crate::Scene, polys: &[usize], id: &[u32]) -> Option<Vec<Edge>> {
     if polys.windows(2).any(|w| scene.polygons[w[0]].face == scene.polygons[w[1]].face) {
         return None; // a face split into a fan (its pieces are consecutive)
     }
