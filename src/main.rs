@@ -4,7 +4,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use umbra::shadow::volumes::Counting;
-use umbra::shadow::ShadowOptions;
+use umbra::shadow::{ShadowFilter, ShadowOptions, WilliamsOptions};
 use umbra::{generate, render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 #[derive(Parser)]
@@ -36,9 +36,10 @@ struct RenderArgs {
     /// Hidden-surface stage: scanline (Watkins), zbuffer, or ray-cast (one ray per pixel).
     #[arg(long, default_value = "scanline", value_parser = parse_visibility)]
     visibility: VisibilityMethod,
-    /// Shadow stage: none, bouknight-kelley (projected shadow polygons), crow (shadow volumes
-    /// counted per span), or ray-cast (per-pixel reference); all but none are exact. The
-    /// default is the engine's recommended exact method.
+    /// Shadow stage. Exact: bouknight-kelley (projected shadow polygons), crow (shadow
+    /// volumes counted per span), stencil-volume (the same volumes counted per pixel),
+    /// ray-cast (per-pixel reference). Approximate: williams (shadow maps), planar (Blinn's
+    /// projection onto receiver planes). Or none. The default is the recommended exact method.
     #[arg(long, default_value = ShadowMethod::DEFAULT.name(), value_parser = parse_shadows)]
     shadows: ShadowMethod,
     /// Write the analysis buffers id.png and light<k>.png into this folder.
@@ -57,10 +58,39 @@ struct RenderArgs {
     /// infinity (zfail), or from zero at the eye (naive-zpass, wrong when the eye is in shadow).
     #[arg(long, default_value = "zpass", value_parser = parse_count)]
     crow_count: Counting,
+    /// Williams: texels along each side of a shadow map.
+    #[arg(long, default_value_t = 2048)]
+    map_size: u32,
+    /// Williams: constant depth bias in world units (default: 0.1% of the scene's size).
+    #[arg(long)]
+    bias: Option<f64>,
+    /// Williams: slope-scaled bias, in texels times the tangent of the angle of incidence.
+    #[arg(long, default_value_t = 1.5)]
+    slope_bias: f64,
+    /// Williams: nearest (one texel), pcf (percentage-closer filtering over --pcf-size²
+    /// texels), or soft-edge (seed 002: PCF into a screen buffer, then a 15-tap Gaussian blur).
+    #[arg(long, value_enum, default_value = "pcf")]
+    shadow_filter: FilterArg,
+    /// Williams: the PCF kernel's side in texels (odd; 3 is seed 002's kernel).
+    #[arg(long, default_value_t = 3)]
+    pcf_size: u32,
+    /// Williams: leave polygons facing the light out of the depth map (seed 003).
+    #[arg(long)]
+    cull_front: bool,
     /// Draw the shadow stage's own polygons for the first light sample over the image
     /// (shadow-polygons: Bouknight-Kelley's projections on their receivers).
     #[arg(long, value_enum)]
     debug: Option<Debug>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FilterArg {
+    /// One texel.
+    Nearest,
+    /// Percentage-closer filtering.
+    Pcf,
+    /// PCF, then seed 002's screen-space blur.
+    SoftEdge,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -125,9 +155,25 @@ fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
             let scene = Scene::load(&a.scene)?;
+            let filter = match a.shadow_filter {
+                FilterArg::Nearest => ShadowFilter::Nearest,
+                FilterArg::Pcf => ShadowFilter::Pcf(a.pcf_size),
+                FilterArg::SoftEdge => ShadowFilter::SoftEdge(a.pcf_size),
+            };
+            if a.map_size == 0 || a.map_size > 16384 || a.pcf_size % 2 == 0 {
+                return Err(umbra::Error::Invalid("--map-size must be 1..=16384 and --pcf-size odd".into()));
+            }
+            let williams = WilliamsOptions {
+                map_size: a.map_size,
+                bias: a.bias,
+                slope_bias: a.slope_bias,
+                filter,
+                cull_front: a.cull_front,
+            };
             let shadow_options = ShadowOptions {
                 prefilter: !a.no_prefilter,
                 crow_count: a.crow_count,
+                williams,
                 keep_outlines: a.debug.is_some(),
             };
             let opts = RenderOptions { visibility: a.visibility, shadows: a.shadows, shadow_options, progress: true };

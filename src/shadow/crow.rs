@@ -25,32 +25,17 @@
 //! takes it as not in front, z-fail as behind, as a depth test `<` would. A per-polygon
 //! volume never counts for its own face.
 
-use super::volumes::{shadow_polygons, Adjacency, Counting, Part};
+use super::volumes::{Adjacency, Counting, ScreenVolumes, NONE};
 use super::{ShadowContext, ShadowStage, ShadowWalker};
 use crate::scan::{boundary, ActiveEdges, EdgeTable};
 use crate::stats::Counters;
-use crate::view::DepthPlane;
 use crate::visibility::Run;
 use glam::DVec2;
-
-const NONE: u32 = u32::MAX;
-
-/// A shadow polygon in screen space.
-#[derive(Debug, Clone, Copy)]
-struct Screened {
-    depth: DepthPlane,
-    /// +1 when the eye sees its outward side.
-    sign: i32,
-    near_cap: bool,
-    lies_on: u32,
-    owner_face: u32,
-}
 
 /// One light sample's shadow polygons, ready to walk.
 struct SampleVolumes {
     table: EdgeTable,
-    polys: Vec<Screened>,
-    rings: Vec<Vec<DVec2>>,
+    volumes: ScreenVolumes,
 }
 
 /// The prepared stage.
@@ -69,42 +54,13 @@ impl<'a> Crow<'a> {
         let samples = ctx
             .all_samples()
             .map(|(_, _, sample)| {
+                let volumes = ScreenVolumes::new(ctx, &adjacency, sample, counting, counters);
                 let mut table = EdgeTable::new(view.height);
-                let mut polys = Vec::new();
-                let mut rings = Vec::new();
-                let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
-                for sp in shadow_polygons(ctx, &adjacency, sample, counting, counters) {
-                    // A back cap lies on the plane at infinity: inverse depth 0, behind all.
-                    let depth = match &sp.plane {
-                        Some(plane) => match view.depth_plane(plane) {
-                            Some(d) => d,
-                            None => continue, // edge-on to the eye
-                        },
-                        None => DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
-                    };
-                    if sp.part == Part::NearCap {
-                        // On the near plane by construction: projected as it is (clipping
-                        // it there would let rounding throw it away).
-                        ring.clear();
-                        ring.extend(sp.verts.iter().map(|&v| view.project(view.to_camera(v.truncate()))));
-                    } else if !view.clip_project_homogeneous(&sp.verts, &mut scratch, &mut ring) {
-                        continue;
-                    }
-                    table.add_ring(polys.len() as u32, &ring);
-                    polys.push(Screened {
-                        depth,
-                        sign: sp.sign,
-                        near_cap: sp.part == Part::NearCap,
-                        lies_on: sp.lies_on.unwrap_or(NONE),
-                        owner_face: sp.owner_face.unwrap_or(NONE),
-                    });
-                    if ctx.options.keep_outlines {
-                        rings.push(ring.clone());
-                    }
+                for (i, ring) in volumes.rings.iter().enumerate() {
+                    table.add_ring(i as u32, ring);
                 }
                 table.finish();
-                counters.add("screen_shadow_polygons", polys.len() as u64);
-                SampleVolumes { table, polys, rings }
+                SampleVolumes { table, volumes }
             })
             .collect();
         Crow { ctx, counting, samples }
@@ -123,7 +79,7 @@ impl ShadowStage for Crow<'_> {
                     aet: ActiveEdges::new(&s.table, 0..h),
                     xs: Vec::new(),
                     cursor: 0,
-                    open: vec![NONE; s.polys.len()],
+                    open: vec![NONE; s.volumes.polys.len()],
                     open_list: Vec::new(),
                 })
                 .collect(),
@@ -136,7 +92,10 @@ impl ShadowStage for Crow<'_> {
     }
 
     fn outlines(&self) -> Vec<Vec<DVec2>> {
-        self.samples.first().map_or_else(Vec::new, |s| s.rings.clone())
+        if !self.ctx.options.keep_outlines {
+            return Vec::new();
+        }
+        self.samples.first().map_or_else(Vec::new, |s| s.volumes.rings.clone())
     }
 }
 
@@ -196,7 +155,7 @@ impl ShadowWalker for Walker<'_> {
 
     fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
         let k = self.stage.ctx.sample_index(light, sample);
-        let polys = &self.stage.samples[k].polys;
+        let polys = &self.stage.samples[k].volumes.polys;
         let scene = self.stage.ctx.scene;
         let b = run.poly;
         let face = scene.polygons[b as usize].face;
@@ -232,31 +191,20 @@ impl ShadowWalker for Walker<'_> {
                 continue;
             }
             let p = &polys[t as usize];
-            if p.owner_face == face {
-                continue;
-            }
-            // Whether polygon p counts at pixel x: in front of the visible point for z-pass,
-            // behind it (ties on the visible polygon included) for z-fail.
+            // What polygon p adds to the count at pixel x (see `count_at`).
             let counts = |x: u32| {
-                let in_front =
-                    p.near_cap || (p.lies_on != b && p.depth.inv_z(x as f64 + 0.5, yc) > bd.inv_z(x as f64 + 0.5, yc));
-                match counting {
-                    Counting::ZFail => !in_front,
-                    _ => in_front,
-                }
+                let xc = x as f64 + 0.5;
+                p.count_at(counting, b, face, xc, yc, bd.inv_z(xc, yc))
             };
-            let sign = if counting == Counting::ZFail { -p.sign } else { p.sign };
             let (first, last) = (counts(s), counts(e - 1));
-            let mut add = |a: u32, z: u32| {
-                if a < z {
-                    self.events.push((a, sign));
-                    self.events.push((z, -sign));
+            let mut add = |a: u32, z: u32, c: i32| {
+                if a < z && c != 0 {
+                    self.events.push((a, c));
+                    self.events.push((z, -c));
                 }
             };
             if first == last {
-                if first {
-                    add(s, e);
-                }
+                add(s, e, first);
                 continue;
             }
             // The planes cross inside [s, e): find the first pixel that counts differently.
@@ -269,11 +217,8 @@ impl ShadowWalker for Walker<'_> {
             while m < e - 1 && counts(m) == first {
                 m += 1;
             }
-            if first {
-                add(s, m);
-            } else {
-                add(m, e);
-            }
+            add(s, m, first);
+            add(m, e, last);
         }
         // Sweep: the count is constant between events.
         self.events.sort_unstable_by_key(|e| e.0);

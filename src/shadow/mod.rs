@@ -9,13 +9,19 @@
 mod bouknight_kelley;
 mod crow;
 mod overlay;
+pub mod planar;
 mod projection;
 mod ray_cast;
+mod stencil_volume;
 pub mod volumes;
+pub mod williams;
 
 pub use bouknight_kelley::BouknightKelley;
 pub use crow::Crow;
+pub use planar::Planar;
 pub use ray_cast::RayCastShadows;
+pub use stencil_volume::StencilVolume;
+pub use williams::{ShadowFilter, Williams, WilliamsOptions};
 
 use crate::error::{Error, Result};
 use crate::scene::{LightSample, Scene};
@@ -30,6 +36,8 @@ pub struct ShadowOptions {
     pub prefilter: bool,
     /// Crow: how the shadow volumes are counted along the line of sight (default z-pass).
     pub crow_count: volumes::Counting,
+    /// Williams' shadow maps: resolution, bias, filter, culling.
+    pub williams: WilliamsOptions,
     /// Keep the screen outlines of the stage's polygons (shadow polygons, detail polygons)
     /// for drawing them over the image.
     pub keep_outlines: bool,
@@ -37,7 +45,12 @@ pub struct ShadowOptions {
 
 impl Default for ShadowOptions {
     fn default() -> Self {
-        ShadowOptions { prefilter: true, crow_count: volumes::Counting::ZPass, keep_outlines: false }
+        ShadowOptions {
+            prefilter: true,
+            crow_count: volumes::Counting::ZPass,
+            williams: WilliamsOptions::default(),
+            keep_outlines: false,
+        }
     }
 }
 
@@ -119,6 +132,12 @@ pub enum ShadowMethod {
     BouknightKelley,
     /// Crow's shadow volumes counted per span.
     Crow,
+    /// Williams' two-pass z-buffer shadow maps (approximate).
+    Williams,
+    /// Shadow volumes counted per pixel in a stencil buffer.
+    StencilVolume,
+    /// Blinn's shadows projected onto marked receiver planes (approximate).
+    Planar,
 }
 
 impl ShadowMethod {
@@ -126,8 +145,15 @@ impl ShadowMethod {
     pub const DEFAULT: ShadowMethod = ShadowMethod::RayCast;
 
     /// Every method.
-    pub const ALL: [ShadowMethod; 4] =
-        [ShadowMethod::None, ShadowMethod::BouknightKelley, ShadowMethod::Crow, ShadowMethod::RayCast];
+    pub const ALL: [ShadowMethod; 7] = [
+        ShadowMethod::None,
+        ShadowMethod::BouknightKelley,
+        ShadowMethod::Crow,
+        ShadowMethod::Williams,
+        ShadowMethod::StencilVolume,
+        ShadowMethod::Planar,
+        ShadowMethod::RayCast,
+    ];
 
     /// The method's name on the command line.
     pub fn name(self) -> &'static str {
@@ -136,12 +162,16 @@ impl ShadowMethod {
             ShadowMethod::RayCast => "ray-cast",
             ShadowMethod::BouknightKelley => "bouknight-kelley",
             ShadowMethod::Crow => "crow",
+            ShadowMethod::Williams => "williams",
+            ShadowMethod::StencilVolume => "stencil-volume",
+            ShadowMethod::Planar => "planar",
         }
     }
 
-    /// Whether the method gives the exact answer of section 3.
+    /// Whether the method gives the exact answer of section 3 (with its exact options:
+    /// Crow and the stencil volumes except with naive z-pass).
     pub fn is_exact(self) -> bool {
-        !matches!(self, ShadowMethod::None)
+        !matches!(self, ShadowMethod::None | ShadowMethod::Williams | ShadowMethod::Planar)
     }
 
     /// Prepares the stage.
@@ -151,6 +181,9 @@ impl ShadowMethod {
             ShadowMethod::RayCast => Box::new(RayCastShadows::new(ctx, counters)),
             ShadowMethod::BouknightKelley => Box::new(BouknightKelley::new(ctx, counters)),
             ShadowMethod::Crow => Box::new(Crow::new(ctx, counters)),
+            ShadowMethod::Williams => Box::new(Williams::new(ctx, counters)),
+            ShadowMethod::StencilVolume => Box::new(StencilVolume::new(ctx, counters)),
+            ShadowMethod::Planar => Box::new(Planar::new(ctx, counters)?),
         })
     }
 }

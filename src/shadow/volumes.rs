@@ -32,7 +32,8 @@ use super::ShadowContext;
 use crate::geometry::Plane;
 use crate::scene::LightSample;
 use crate::stats::Counters;
-use glam::{DVec3, DVec4};
+use crate::view::DepthPlane;
+use glam::{DVec2, DVec3, DVec4};
 
 /// How a count is taken along the line of sight.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -330,4 +331,96 @@ fn closed_edges(scene: &crate::Scene, polys: &[usize], id: &[u32]) -> Option<Vec
         }
     }
     Some(edges)
+}
+
+/// A shadow polygon in screen space.
+#[derive(Debug, Clone, Copy)]
+pub struct ScreenShadowPolygon {
+    /// Its inverse depth over the screen (all zero on the plane at infinity).
+    pub depth: DepthPlane,
+    /// +1 when the eye sees its outward side.
+    pub sign: i32,
+    /// A near cap: in front of every visible point.
+    pub near_cap: bool,
+    /// For a front cap, the scene polygon it is ([`NONE`] otherwise).
+    pub lies_on: u32,
+    /// For a per-polygon volume, its face ([`NONE`] otherwise).
+    pub owner_face: u32,
+}
+
+/// No polygon.
+pub const NONE: u32 = u32::MAX;
+
+impl ScreenShadowPolygon {
+    /// What this polygon adds to the count at screen position `(x, y)` where polygon `poly`
+    /// (of face `face`, inverse depth `surface` there) is seen: z-pass counts it with its sign
+    /// when it lies in front of the visible point, z-fail with the opposite sign when it lies
+    /// behind. A front cap that is the visible polygon lies exactly at the point: not in front
+    /// (z-pass), behind (z-fail), as a depth test `<` has it. A per-polygon volume never
+    /// counts on its own face.
+    #[inline]
+    pub fn count_at(&self, counting: Counting, poly: u32, face: u32, x: f64, y: f64, surface: f64) -> i32 {
+        if self.owner_face == face {
+            return 0;
+        }
+        let in_front = self.near_cap || (self.lies_on != poly && self.depth.inv_z(x, y) > surface);
+        match counting {
+            Counting::ZFail if !in_front => -self.sign,
+            Counting::ZFail => 0,
+            _ if in_front => self.sign,
+            _ => 0,
+        }
+    }
+}
+
+/// One light sample's shadow polygons in screen space, with their outlines.
+pub struct ScreenVolumes {
+    /// The polygons.
+    pub polys: Vec<ScreenShadowPolygon>,
+    /// Their screen outlines, parallel to `polys`.
+    pub rings: Vec<Vec<DVec2>>,
+}
+
+impl ScreenVolumes {
+    /// The shadow polygons of `sample` for `counting`, put through the camera: clipped to the
+    /// near plane in homogeneous coordinates (never to the far plane) and projected.
+    pub fn new(
+        ctx: &ShadowContext,
+        adjacency: &Adjacency,
+        sample: LightSample,
+        counting: Counting,
+        counters: &mut Counters,
+    ) -> Self {
+        let view = ctx.view;
+        let mut out = ScreenVolumes { polys: Vec::new(), rings: Vec::new() };
+        let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
+        for sp in shadow_polygons(ctx, adjacency, sample, counting, counters) {
+            // A back cap lies on the plane at infinity: inverse depth 0, behind everything.
+            let depth = match &sp.plane {
+                Some(plane) => match view.depth_plane(plane) {
+                    Some(d) => d,
+                    None => continue, // edge-on to the eye
+                },
+                None => DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
+            };
+            if sp.part == Part::NearCap {
+                // On the near plane by construction: projected as it is (clipping it there
+                // would let rounding throw it away).
+                ring.clear();
+                ring.extend(sp.verts.iter().map(|&v| view.project(view.to_camera(v.truncate()))));
+            } else if !view.clip_project_homogeneous(&sp.verts, &mut scratch, &mut ring) {
+                continue;
+            }
+            out.rings.push(ring.clone());
+            out.polys.push(ScreenShadowPolygon {
+                depth,
+                sign: sp.sign,
+                near_cap: sp.part == Part::NearCap,
+                lies_on: sp.lies_on.unwrap_or(NONE),
+                owner_face: sp.owner_face.unwrap_or(NONE),
+            });
+        }
+        counters.add("screen_shadow_polygons", out.polys.len() as u64);
+        out
+    }
 }

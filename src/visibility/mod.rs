@@ -8,7 +8,7 @@ mod zbuffer;
 
 pub use ray_cast::RayCastVisibility;
 pub use scanline::ScanlineVisibility;
-pub use zbuffer::ZBufferVisibility;
+pub use zbuffer::{rasterize, Depth, DepthBuffer, ZBufferVisibility};
 
 use crate::error::{Error, Result};
 use crate::scene::Scene;

@@ -20,56 +20,108 @@ pub struct ZBufferVisibility {
 impl ZBufferVisibility {
     /// Rasterises every screen polygon into the buffers.
     pub fn new(screen: &[ScreenPolygon], view: &View, counters: &mut Counters) -> Self {
-        let (w, h) = (view.width as usize, view.height);
-        let spans: Vec<Range<u32>> = screen
-            .iter()
-            .map(|p| {
-                let (lo, hi) =
-                    p.ring.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(q.y), hi.max(q.y)));
-                let first = (lo - 0.5).ceil().clamp(0.0, h as f64) as u32;
-                let end = (hi - 0.5).ceil().clamp(0.0, h as f64) as u32;
-                first..end
-            })
-            .collect();
-        let mut ids = vec![u32::MAX; w * h as usize];
-        let mut depth = vec![0.0f64; w * h as usize];
-        let band = crate::render::band_height(h);
-        let counts: Vec<(u64, u64)> = ids
-            .par_chunks_mut(w * band as usize)
-            .zip(depth.par_chunks_mut(w * band as usize))
-            .enumerate()
-            .map(|(bi, (ids, depth))| {
-                let y0 = bi as u32 * band;
-                let lines = y0..(y0 + band).min(h);
-                let mut table = EdgeTable::new(h);
-                let (mut tests, mut writes) = (0u64, 0u64);
-                for (p, r) in screen.iter().zip(&spans) {
-                    if r.end <= lines.start || r.start >= lines.end {
-                        continue;
-                    }
-                    for_each_span(&mut table, &[&p.ring], view.width, h, lines.clone(), |y, x0, x1| {
-                        let yc = y as f64 + 0.5;
-                        let row = (y - y0) as usize * w;
-                        tests += (x1 - x0) as u64;
-                        for x in x0..x1 {
-                            let z = p.depth.inv_z(x as f64 + 0.5, yc);
-                            let k = row + x as usize;
-                            if z > depth[k] {
-                                depth[k] = z;
-                                ids[k] = p.poly;
-                                writes += 1;
-                            }
-                        }
-                    });
-                }
-                (tests, writes)
-            })
-            .collect();
-        counters.add("depth_tests", counts.iter().map(|c| c.0).sum());
-        counters.add("depth_writes", counts.iter().map(|c| c.1).sum());
-        counters.add("buffer_bytes", (ids.len() * 4 + depth.len() * 8) as u64);
-        ZBufferVisibility { width: view.width, ids }
+        let buffers = rasterize::<f64>(screen, view.width, view.height, true);
+        counters.add("depth_tests", buffers.tests);
+        counters.add("depth_writes", buffers.writes);
+        counters.add("buffer_bytes", (buffers.ids.len() * 4 + buffers.depth.len() * 8) as u64);
+        ZBufferVisibility { width: view.width, ids: buffers.ids }
     }
+}
+
+/// A depth value a buffer can hold: `f64` for visibility, `f32` for shadow maps.
+pub trait Depth: Copy + PartialOrd + Send + Sync {
+    /// Nothing drawn (farther than anything).
+    const FAR: Self;
+    /// From a depth-plane value.
+    fn from_f64(v: f64) -> Self;
+}
+
+impl Depth for f64 {
+    const FAR: Self = f64::NEG_INFINITY;
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+}
+
+impl Depth for f32 {
+    const FAR: Self = f32::NEG_INFINITY;
+    fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+}
+
+/// A filled depth buffer: the nearest polygon and its nearness (a [`DepthPlane`] value, larger
+/// is nearer; [`Depth::FAR`] where nothing was drawn) at each pixel centre.
+///
+/// [`DepthPlane`]: crate::view::DepthPlane
+pub struct DepthBuffer<D> {
+    /// `ScreenPolygon::poly` of the nearest polygon per pixel, `u32::MAX` for none; empty
+    /// when ids were not asked for.
+    pub ids: Vec<u32>,
+    /// Its nearness per pixel.
+    pub depth: Vec<D>,
+    /// Pixels tested.
+    pub tests: u64,
+    /// Pixels written.
+    pub writes: u64,
+}
+
+/// The z-buffer loop: rasterises `screen` one polygon at a time, keeping at each pixel
+/// centre the polygon whose depth plane is largest (nearest), in parallel bands of lines.
+/// Used for visibility (with ids, in f64) and, from the light, for Williams' shadow maps
+/// (depth only, in f32).
+pub fn rasterize<D: Depth>(screen: &[ScreenPolygon], width: u32, height: u32, with_ids: bool) -> DepthBuffer<D> {
+    let (w, h) = (width as usize, height);
+    let spans: Vec<Range<u32>> = screen
+        .iter()
+        .map(|p| {
+            let (lo, hi) =
+                p.ring.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(q.y), hi.max(q.y)));
+            let first = (lo - 0.5).ceil().clamp(0.0, h as f64) as u32;
+            let end = (hi - 0.5).ceil().clamp(0.0, h as f64) as u32;
+            first..end
+        })
+        .collect();
+    let mut ids = if with_ids { vec![u32::MAX; w * h as usize] } else { Vec::new() };
+    let mut depth = vec![D::FAR; w * h as usize];
+    let band = crate::render::band_height(h);
+    let chunk = w * band as usize;
+    let mut id_chunks: Vec<&mut [u32]> = ids.chunks_mut(chunk).collect();
+    id_chunks.resize_with(depth.len().div_ceil(chunk), || &mut []);
+    let counts: Vec<(u64, u64)> = depth
+        .par_chunks_mut(chunk)
+        .zip(id_chunks.into_par_iter())
+        .enumerate()
+        .map(|(bi, (depth, ids))| {
+            let y0 = bi as u32 * band;
+            let lines = y0..(y0 + band).min(h);
+            let mut table = EdgeTable::new(h);
+            let (mut tests, mut writes) = (0u64, 0u64);
+            for (p, r) in screen.iter().zip(&spans) {
+                if r.end <= lines.start || r.start >= lines.end {
+                    continue;
+                }
+                for_each_span(&mut table, &[&p.ring], width, h, lines.clone(), |y, x0, x1| {
+                    let yc = y as f64 + 0.5;
+                    let row = (y - y0) as usize * w;
+                    tests += (x1 - x0) as u64;
+                    for x in x0..x1 {
+                        let z = D::from_f64(p.depth.inv_z(x as f64 + 0.5, yc));
+                        let k = row + x as usize;
+                        if z > depth[k] {
+                            depth[k] = z;
+                            if let Some(id) = ids.get_mut(k) {
+                                *id = p.poly;
+                            }
+                            writes += 1;
+                        }
+                    }
+                });
+            }
+            (tests, writes)
+        })
+        .collect();
+    DepthBuffer { ids, depth, tests: counts.iter().map(|c| c.0).sum(), writes: counts.iter().map(|c| c.1).sum() }
 }
 
 impl Visibility for ZBufferVisibility {

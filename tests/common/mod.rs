@@ -56,6 +56,16 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod, ShadowOptions)> {
         ),
         ("crow zpass".into(), ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZPass, ..d() }),
         ("crow zfail".into(), ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZFail, ..d() }),
+        (
+            "stencil-volume zpass".into(),
+            ShadowMethod::StencilVolume,
+            ShadowOptions { crow_count: Counting::ZPass, ..d() },
+        ),
+        (
+            "stencil-volume zfail".into(),
+            ShadowMethod::StencilVolume,
+            ShadowOptions { crow_count: Counting::ZFail, ..d() },
+        ),
     ]
 }
 

@@ -1,0 +1,100 @@
+//! Stencil shadow volumes (Heidmann 1991; Everitt & Kilgard 2002): the z-buffer twin of
+//! Crow's per-span counting. The same shadow polygons ([`super::volumes`]) are rasterised one
+//! at a time, pixel by pixel, into a stencil count against the depth of the visible surface,
+//! as a GPU does with the stencil buffer: z-pass adds each polygon's sign where it lies in
+//! front of the visible surface, z-fail subtracts it where it lies behind. A pixel is in
+//! shadow where its count is above zero.
+
+use super::volumes::{Adjacency, ScreenVolumes};
+use super::{ShadowContext, ShadowStage, ShadowWalker};
+use crate::scan::{for_each_span, EdgeTable};
+use crate::stats::Counters;
+use crate::view::DepthPlane;
+use crate::visibility::Run;
+use rayon::prelude::*;
+
+/// The prepared stage: every sample's lit mask.
+pub struct StencilVolume<'a> {
+    ctx: &'a ShadowContext<'a>,
+    /// `lit[sample][pixel]`.
+    lit: Vec<Vec<bool>>,
+}
+
+impl<'a> StencilVolume<'a> {
+    /// Rasterises every light sample's shadow polygons into a stencil count.
+    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
+        let view = ctx.view;
+        let (w, h) = (view.width as usize, view.height);
+        let scene = ctx.scene;
+        // The depth buffer of the visible surfaces, from the visibility stage's runs.
+        let mut surface = vec![u32::MAX; w * h as usize];
+        for (y, runs) in ctx.runs.lines.iter().enumerate() {
+            for r in runs {
+                surface[y * w + r.x0 as usize..y * w + r.x1 as usize].fill(r.poly);
+            }
+        }
+        let planes: Vec<Option<DepthPlane>> = scene.polygons.iter().map(|p| view.depth_plane(&p.plane)).collect();
+        let adjacency = Adjacency::new(scene);
+        let counting = ctx.options.crow_count;
+        let band = crate::render::band_height(h);
+        let mut writes = 0u64;
+        let lit = ctx
+            .all_samples()
+            .map(|(_, _, sample)| {
+                let vols = ScreenVolumes::new(ctx, &adjacency, sample, counting, counters);
+                let mut stencil = vec![0i32; w * h as usize];
+                let written: u64 = stencil
+                    .par_chunks_mut(w * band as usize)
+                    .enumerate()
+                    .map(|(bi, rows)| {
+                        let y0 = bi as u32 * band;
+                        let lines = y0..(y0 + band).min(h);
+                        let mut table = EdgeTable::new(h);
+                        let mut n = 0u64;
+                        for (sp, ring) in vols.polys.iter().zip(&vols.rings) {
+                            for_each_span(&mut table, &[ring], view.width, h, lines.clone(), |y, x0, x1| {
+                                let yc = y as f64 + 0.5;
+                                for x in x0..x1 {
+                                    let k = y as usize * w + x as usize;
+                                    let poly = surface[k];
+                                    let Some(Some(d)) = planes.get(poly as usize) else { continue };
+                                    let xc = x as f64 + 0.5;
+                                    let face = scene.polygons[poly as usize].face;
+                                    let c = sp.count_at(counting, poly, face, xc, yc, d.inv_z(xc, yc));
+                                    rows[k - y0 as usize * w] += c;
+                                    n += (c != 0) as u64;
+                                }
+                            });
+                        }
+                        n
+                    })
+                    .sum();
+                writes += written;
+                stencil.into_iter().map(|c| c <= 0).collect()
+            })
+            .collect();
+        counters.add("stencil_writes", writes);
+        StencilVolume { ctx, lit }
+    }
+}
+
+impl ShadowStage for StencilVolume<'_> {
+    fn walker(&self) -> Box<dyn ShadowWalker + '_> {
+        Box::new(Walker { stage: self })
+    }
+}
+
+struct Walker<'s> {
+    stage: &'s StencilVolume<'s>,
+}
+
+impl ShadowWalker for Walker<'_> {
+    fn lit(&mut self, light: usize, sample: usize, line: u32, run: &Run, lit: &mut [f32]) {
+        let st = self.stage;
+        let row = line as usize * st.ctx.view.width as usize;
+        let mask = &st.lit[st.ctx.sample_index(light, sample)][row + run.x0 as usize..row + run.x1 as usize];
+        for (o, &m) in lit.iter_mut().zip(mask) {
+            *o = if m { 1.0 } else { 0.0 };
+        }
+    }
+}

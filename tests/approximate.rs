@@ -1,0 +1,129 @@
+//! The approximate z-buffer-era methods show known behaviour: a shadow map with enough bias
+//! and resolution matches ray-cast except within a few pixels of shadow edges; Blinn's
+//! planar shadows are right on a floor under a single box, and fail where they must.
+
+mod common;
+
+use common::*;
+use std::path::Path;
+use umbra::shadow::{ShadowFilter, ShadowOptions, WilliamsOptions};
+use umbra::{Frame, Scene, ShadowMethod, VisibilityMethod};
+
+fn floor_and_box(receiver: bool, light: &str) -> Scene {
+    let src = format!(
+        "[camera]\neye = [0.0, 4.0, 6.0]\ntarget = [0.0, 0.5, 0.0]\nwidth = 240\nheight = 180\n\
+         {light}\n\
+         [[object]]\npolygons = [[[-4.0,0.0,-4.0],[-4.0,0.0,4.0],[4.0,0.0,4.0],[4.0,0.0,-4.0]]]\nreceiver = {receiver}\n\
+         [[object]]\npolygons = [\n\
+          [[-0.5,1.5,-0.5],[-0.5,1.5,0.5],[0.5,1.5,0.5],[0.5,1.5,-0.5]],\n\
+          [[-0.5,0.5,0.5],[0.5,0.5,0.5],[0.5,1.5,0.5],[-0.5,1.5,0.5]],\n\
+          [[-0.5,0.5,-0.5],[-0.5,1.5,-0.5],[0.5,1.5,-0.5],[0.5,0.5,-0.5]],\n\
+          [[-0.5,0.5,-0.5],[-0.5,0.5,0.5],[-0.5,1.5,0.5],[-0.5,1.5,-0.5]],\n\
+          [[0.5,0.5,-0.5],[0.5,1.5,-0.5],[0.5,1.5,0.5],[0.5,0.5,0.5]],\n\
+          [[-0.5,0.5,-0.5],[0.5,0.5,-0.5],[0.5,0.5,0.5],[-0.5,0.5,0.5]]]\n"
+    );
+    Scene::from_toml(&src, Path::new("t.toml"), Path::new(".")).unwrap()
+}
+
+const POINT: &str = "[[light]]\nkind = \"point\"\nposition = [1.5, 5.0, 1.0]\n";
+const DIRECTIONAL: &str = "[[light]]\nkind = \"directional\"\ndirection = [-0.4, -1.0, -0.3]\n";
+
+/// Pixels where `got` differs from `want` in light 0, and of those the ones farther than
+/// `radius` pixels from any change of `want`'s light 0 value (a shadow edge).
+fn errors_away_from_edges(want: &Frame, got: &Frame, radius: i64) -> (usize, Vec<(u32, u32)>) {
+    let (w, h) = (want.width as i64, want.height as i64);
+    let mut wrong = 0;
+    let mut far = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let k = (y * w + x) as usize;
+            if want.id[k] != got.id[k] || want.light[0][k] == got.light[0][k] {
+                continue;
+            }
+            wrong += 1;
+            let near_edge = (-radius..=radius).any(|dy| {
+                (-radius..=radius).any(|dx| {
+                    let (xx, yy) = (x + dx, y + dy);
+                    xx >= 0 && yy >= 0 && xx < w && yy < h && {
+                        let j = (yy * w + xx) as usize;
+                        want.light[0][j] != want.light[0][k] || want.id[j] != want.id[k]
+                    }
+                })
+            });
+            if !near_edge {
+                far.push((x as u32, y as u32));
+            }
+        }
+    }
+    (wrong, far)
+}
+
+#[test]
+fn shadow_map_matches_except_near_shadow_edges() {
+    for light in [POINT, DIRECTIONAL] {
+        let scene = floor_and_box(false, light);
+        let want = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::RayCast);
+        for filter in [ShadowFilter::Nearest, ShadowFilter::Pcf(3)] {
+            let options = ShadowOptions {
+                williams: WilliamsOptions { map_size: 2048, filter, ..WilliamsOptions::default() },
+                ..ShadowOptions::default()
+            };
+            let got = frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams, options);
+            let (wrong, far) = errors_away_from_edges(&want, &got, 3);
+            assert!(
+                far.is_empty(),
+                "{filter:?}: {} of {wrong} errors lie away from shadow edges: {:?}",
+                far.len(),
+                &far[..far.len().min(8)]
+            );
+        }
+    }
+}
+
+#[test]
+fn shadow_map_without_bias_shows_acne() {
+    let scene = floor_and_box(false, POINT);
+    let want = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::RayCast);
+    let options = ShadowOptions {
+        williams: WilliamsOptions {
+            map_size: 512,
+            bias: Some(0.0),
+            slope_bias: 0.0,
+            filter: ShadowFilter::Nearest,
+            cull_front: false,
+        },
+        ..ShadowOptions::default()
+    };
+    let got = frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams, options);
+    let (_, far) = errors_away_from_edges(&want, &got, 3);
+    assert!(far.len() > 500, "self-shadowing acne expected on lit surfaces, found {} pixels", far.len());
+}
+
+#[test]
+fn planar_shadows_are_exact_on_the_receiver_under_one_box() {
+    for light in [POINT, DIRECTIONAL] {
+        let scene = floor_and_box(true, light);
+        let want = frame(&scene, VisibilityMethod::RayCast, ShadowMethod::RayCast);
+        let got = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::Planar);
+        assert!(assert_light_agree(&want, &got, "planar") > 10000);
+        assert!(shadowed_interior(&want) > 300, "{}", shadowed_interior(&want));
+    }
+}
+
+#[test]
+fn planar_shadows_need_a_receiver() {
+    let scene = floor_and_box(false, POINT);
+    let opts = umbra::RenderOptions { shadows: ShadowMethod::Planar, ..Default::default() };
+    let err = umbra::render(&scene, &opts).unwrap_err().to_string();
+    assert!(err.contains("receiver = true"), "{err}");
+}
+
+#[test]
+fn seed_gaussian_weights() {
+    let taps = umbra::shadow::williams::seed_gaussian_taps();
+    assert_eq!(taps.len(), 15);
+    let offsets: Vec<i64> = taps.iter().map(|t| t.0).collect();
+    assert_eq!(offsets, vec![0, 1, -1, 3, -3, 5, -5, 7, -7, 9, -9, 11, -11, 13, -13]);
+    let sum: f32 = taps.iter().map(|t| t.1).sum();
+    assert!((sum - 1.0665).abs() < 1e-3, "{sum}");
+}
