@@ -174,6 +174,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
                 prefilter: !a.no_prefilter,
                 crow_count: a.crow_count,
                 williams,
+                awg_database: None,
                 keep_outlines: a.debug.is_some(),
             };
             let opts = RenderOptions { visibility: a.visibility, shadows: a.shadows, shadow_options, progress: true };

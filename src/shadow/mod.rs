@@ -6,6 +6,7 @@
 //! is in shadow from it — Bouknight and Kelley's self-shadowing test) is applied once by the
 //! pipeline, before any stage is asked; stages only answer for runs the rule leaves lit.
 
+pub mod atherton_weiler_greenberg;
 mod bouknight_kelley;
 mod crow;
 mod overlay;
@@ -16,6 +17,7 @@ mod stencil_volume;
 pub mod volumes;
 pub mod williams;
 
+pub use atherton_weiler_greenberg::{AthertonWeilerGreenberg, ShadowDatabase};
 pub use bouknight_kelley::BouknightKelley;
 pub use crow::Crow;
 pub use planar::Planar;
@@ -38,6 +40,9 @@ pub struct ShadowOptions {
     pub crow_count: volumes::Counting,
     /// Williams' shadow maps: resolution, bias, filter, culling.
     pub williams: WilliamsOptions,
+    /// Atherton-Weiler-Greenberg: a shadow database built beforehand (one per light), to
+    /// render many views of one database; `None` builds it.
+    pub awg_database: Option<std::sync::Arc<Vec<ShadowDatabase>>>,
     /// Keep the screen outlines of the stage's polygons (shadow polygons, detail polygons)
     /// for drawing them over the image.
     pub keep_outlines: bool,
@@ -49,6 +54,7 @@ impl Default for ShadowOptions {
             prefilter: true,
             crow_count: volumes::Counting::ZPass,
             williams: WilliamsOptions::default(),
+            awg_database: None,
             keep_outlines: false,
         }
     }
@@ -132,6 +138,8 @@ pub enum ShadowMethod {
     BouknightKelley,
     /// Crow's shadow volumes counted per span.
     Crow,
+    /// Atherton-Weiler-Greenberg: hidden-surface removal from the light, lit detail polygons.
+    AthertonWeilerGreenberg,
     /// Williams' two-pass z-buffer shadow maps (approximate).
     Williams,
     /// Shadow volumes counted per pixel in a stencil buffer.
@@ -145,9 +153,10 @@ impl ShadowMethod {
     pub const DEFAULT: ShadowMethod = ShadowMethod::RayCast;
 
     /// Every method.
-    pub const ALL: [ShadowMethod; 7] = [
+    pub const ALL: [ShadowMethod; 8] = [
         ShadowMethod::None,
         ShadowMethod::BouknightKelley,
+        ShadowMethod::AthertonWeilerGreenberg,
         ShadowMethod::Crow,
         ShadowMethod::Williams,
         ShadowMethod::StencilVolume,
@@ -162,6 +171,7 @@ impl ShadowMethod {
             ShadowMethod::RayCast => "ray-cast",
             ShadowMethod::BouknightKelley => "bouknight-kelley",
             ShadowMethod::Crow => "crow",
+            ShadowMethod::AthertonWeilerGreenberg => "atherton-weiler-greenberg",
             ShadowMethod::Williams => "williams",
             ShadowMethod::StencilVolume => "stencil-volume",
             ShadowMethod::Planar => "planar",
@@ -181,6 +191,7 @@ impl ShadowMethod {
             ShadowMethod::RayCast => Box::new(RayCastShadows::new(ctx, counters)),
             ShadowMethod::BouknightKelley => Box::new(BouknightKelley::new(ctx, counters)),
             ShadowMethod::Crow => Box::new(Crow::new(ctx, counters)),
+            ShadowMethod::AthertonWeilerGreenberg => Box::new(AthertonWeilerGreenberg::new(ctx, counters)?),
             ShadowMethod::Williams => Box::new(Williams::new(ctx, counters)),
             ShadowMethod::StencilVolume => Box::new(StencilVolume::new(ctx, counters)),
             ShadowMethod::Planar => Box::new(Planar::new(ctx, counters)?),

@@ -38,12 +38,19 @@ impl Overlay {
 
     /// Adds a polygon lying on scene polygon `receiver`; returns its tag.
     pub fn add(&mut self, receiver: u32, ring: &[DVec2]) -> u32 {
+        self.add_rings(receiver, std::slice::from_ref(&ring.to_vec()))
+    }
+
+    /// Adds a polygon with several rings (holes, by the even-odd rule) lying on `receiver`.
+    pub fn add_rings(&mut self, receiver: u32, rings: &[Vec<DVec2>]) -> u32 {
         let tag = self.receiver.len() as u32;
-        self.table.add_ring(tag, ring);
-        self.receiver.push(receiver);
-        if self.keep_rings {
-            self.rings.push(ring.to_vec());
+        for ring in rings {
+            self.table.add_ring(tag, ring);
+            if self.keep_rings {
+                self.rings.push(ring.clone());
+            }
         }
+        self.receiver.push(receiver);
         tag
     }
 

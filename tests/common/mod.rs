@@ -54,6 +54,7 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod, ShadowOptions)> {
             ShadowMethod::BouknightKelley,
             ShadowOptions { prefilter: false, ..d() },
         ),
+        ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg, d()),
         ("crow zpass".into(), ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZPass, ..d() }),
         ("crow zfail".into(), ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZFail, ..d() }),
         (

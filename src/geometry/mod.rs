@@ -1,5 +1,8 @@
 //! Planar polygons in f64: Newell normals, planes, the planarity and degeneracy rules of
-//! `SCENE_FORMAT.md` section 2, clipping by a plane, and point-in-polygon by the even-odd rule.
+//! `SCENE_FORMAT.md` section 2, clipping by a plane, point-in-polygon by the even-odd rule,
+//! and Weiler-Atherton polygon clipping ([`weiler_atherton`]).
+
+pub mod weiler_atherton;
 
 use glam::{DVec2, DVec3};
 

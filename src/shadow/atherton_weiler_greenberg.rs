@@ -1,0 +1,486 @@
+//! The two-pass object-space shadow algorithm of Atherton, Weiler & Greenberg ("Polygon
+//! shadow generation", SIGGRAPH 1978), as seed 004 lays it out:
+//!
+//! 1. **Hidden-surface removal from the light.** (a) The scene is transformed into the
+//!    light's view: a perspective view for point, spot and area-light samples, split into the
+//!    six 90° faces of a cube around the light so nothing is lost at the seams; a parallel
+//!    view for a directional light. (b) The visible parts are found by Weiler & Atherton's
+//!    area sorting ([`visible`]): a rough depth sort, then the front polygon's outline clips
+//!    everything into inside and outside lists ([`crate::geometry::weiler_atherton`]); what
+//!    lies inside and behind it is hidden, and when something inside lies in front after all
+//!    (the sort was wrong) that part is resolved first, recursively. (c) The visible
+//!    fragments are taken back onto their source polygons' planes in world space.
+//! 2. **Merge.** The lit fragments become *surface-detail polygons* of their source polygons:
+//!    the [`ShadowDatabase`]. It does not depend on the camera: build it once per light and
+//!    render it from any number of views (`ShadowOptions::awg_database`), or export it.
+//! 3. and 4. **The view pass.** Hidden-surface removal from the eye is the visibility stage;
+//!    each visible run is lit exactly where its polygon's detail polygons cover it, found by
+//!    walking the detail polygons with the shared edge and active-edge tables.
+//!
+//! Polygons that cast no shadow still receive light: they are left out of the sort and then
+//! lit where no visible caster fragment lies in front of them. The pieces of a non-planar
+//! face (split into a fan by the loader) never shadow each other: each gets its lit part
+//! from a sort that leaves its sibling pieces out. Area lights get one database
+//! per sample; the lit fraction is the share of samples that light a point.
+
+use super::overlay::{Interval, Overlay, OverlayWalker};
+use super::projection::edge_on;
+use super::{ShadowContext, ShadowStage, ShadowWalker};
+use crate::error::{Error, Result};
+use crate::geometry::weiler_atherton::{clip, ClipError, Region};
+use crate::geometry::{clip_polygon, Plane};
+use crate::scene::{LightSample, Scene};
+use crate::stats::Counters;
+use crate::view::DepthPlane;
+use crate::visibility::Run;
+use glam::{DVec2, DVec3};
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// A lit fragment of a scene polygon: where one light sample reaches it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DetailPolygon {
+    /// Index of the scene polygon it lies on.
+    pub source: u32,
+    /// Its outlines in world space, on the source's plane (even-odd).
+    pub rings: Vec<Vec<DVec3>>,
+}
+
+/// The lit detail polygons of one light: `samples[s]` for each of its samples.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ShadowDatabase {
+    /// Per sample, the lit fragments.
+    pub samples: Vec<Vec<DetailPolygon>>,
+}
+
+/// A polygon (or a piece of one) in a light view: its region in the view's 2D coordinates
+/// and its nearness to the light there (an affine function: larger is nearer).
+#[derive(Debug, Clone)]
+struct Piece {
+    source: u32,
+    region: Region,
+    near: DepthPlane,
+    bounds: (DVec2, DVec2),
+}
+
+impl Piece {
+    fn new(source: u32, region: Region, near: DepthPlane) -> Option<Piece> {
+        let bounds = region.bounds()?;
+        Some(Piece { source, region, near, bounds })
+    }
+
+    fn overlaps(&self, other: &Piece) -> bool {
+        let (a, b) = (self.bounds, other.bounds);
+        a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y
+    }
+
+    /// The nearest any of its vertices gets (the rough sort's key).
+    fn nearest(&self) -> f64 {
+        self.region.rings.iter().flatten().map(|p| self.near.inv_z(p.x, p.y)).fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// Counters of pass 1.
+#[derive(Debug, Default)]
+struct Pass1 {
+    fragments: u64,
+    clips: u64,
+    depth_max: u64,
+    splits: u64,
+}
+
+/// How a piece lies relative to a clip polygon over the piece's own area.
+enum Relation {
+    Behind,
+    Front,
+    Mixed,
+}
+
+fn relation(q: &Piece, clip: &Piece) -> Relation {
+    let (mut front, mut behind) = (false, false);
+    let scale =
+        q.region.rings.iter().flatten().map(|p| clip.near.inv_z(p.x, p.y).abs()).fold(0.0, f64::max).max(1e-300);
+    let tol = 1e-9 * scale;
+    for p in q.region.rings.iter().flatten() {
+        let d = q.near.inv_z(p.x, p.y) - clip.near.inv_z(p.x, p.y);
+        front |= d > tol;
+        behind |= d < -tol;
+    }
+    match (front, behind) {
+        (true, true) => Relation::Mixed,
+        (true, false) => Relation::Front,
+        _ => Relation::Behind, // behind, or coplanar (either may be seen)
+    }
+}
+
+/// The part of `q` where it is nearer than `clip` (they interpenetrate): `q` clipped by the
+/// half-plane where the difference of their nearness functions is positive.
+fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::Result<Option<Piece>, ClipError> {
+    let (a, b) = (&q.near, &clip_piece.near);
+    let (da, db, dc) = (a.a - b.a, a.b - b.b, a.c - b.c);
+    let (lo, hi) = q.bounds;
+    let pad = (hi - lo).max_element().max(1e-12);
+    let (lo, hi) = (lo - DVec2::splat(pad), hi + DVec2::splat(pad));
+    let rect = [DVec2::new(lo.x, lo.y), DVec2::new(hi.x, lo.y), DVec2::new(hi.x, hi.y), DVec2::new(lo.x, hi.y)];
+    let mut half = Vec::new();
+    clip_polygon(&rect, |p: DVec2| da * p.x + db * p.y + dc, &mut half);
+    stats.splits += 1;
+    if half.len() < 3 {
+        return Ok(None);
+    }
+    stats.clips += 1;
+    let c = clip(&q.region, &Region::from_ring(half))?;
+    Ok(Piece::new(q.source, c.inside, q.near))
+}
+
+/// Weiler & Atherton's hidden-surface removal by area sorting: the parts of `list` that
+/// nothing in the list hides.
+fn visible(mut list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
+    stats.depth_max = stats.depth_max.max(depth);
+    // The rough depth sort: nearest vertex first.
+    list.sort_by(|a, b| b.nearest().total_cmp(&a.nearest()));
+    let mut out = Vec::new();
+    let mut list = std::collections::VecDeque::from(list);
+    while let Some(front) = list.pop_front() {
+        // The front polygon's outline splits everything it overlaps into inside and outside.
+        let mut inside = Vec::new();
+        let mut rest = std::collections::VecDeque::with_capacity(list.len());
+        for q in list.drain(..) {
+            if !q.overlaps(&front) {
+                rest.push_back(q);
+                continue;
+            }
+            stats.clips += 1;
+            let c = clip(&q.region, &front.region)?;
+            if let Some(p) = Piece::new(q.source, c.inside, q.near) {
+                inside.push(p);
+            }
+            if let Some(p) = Piece::new(q.source, c.outside, q.near) {
+                rest.push_back(p);
+            }
+        }
+        list = rest;
+        // Inside: hidden where behind the front polygon; where in front, the sort was wrong.
+        let mut fronts = Vec::new();
+        for q in inside {
+            match relation(&q, &front) {
+                Relation::Behind => {}
+                Relation::Front => fronts.push(q),
+                Relation::Mixed => fronts.extend(front_part(&q, &front, stats)?),
+            }
+        }
+        if fronts.is_empty() {
+            out.push(front);
+            continue;
+        }
+        // Resolve what is in front first, then keep the front polygon where none of it is.
+        let seen = visible(fronts, depth + 1, stats)?;
+        let mut remains = front.region.clone();
+        for s in &seen {
+            stats.clips += 1;
+            remains = clip(&remains, &s.region)?.outside;
+            if remains.is_empty() {
+                break;
+            }
+        }
+        out.extend(seen);
+        out.extend(Piece::new(front.source, remains, front.near));
+    }
+    stats.fragments += out.len() as u64;
+    Ok(out)
+}
+
+/// The part of `o` (a polygon that casts no shadow) that no visible caster piece in `seen`
+/// lies in front of.
+fn unshadowed(o: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Result<Region, ClipError> {
+    let mut lit = o.region.clone();
+    for s in seen.iter().filter(|s| s.overlaps(&o)) {
+        stats.clips += 1;
+        let c = clip(&lit, &s.region)?;
+        lit = c.outside;
+        // Over the overlap, the caster hides `o` where it is nearer.
+        let Some(overlap) = Piece::new(o.source, c.inside, o.near) else { continue };
+        let caster = Piece { near: s.near, ..overlap.clone() };
+        let kept = match relation(&caster, &overlap) {
+            Relation::Behind => overlap.region,
+            Relation::Front => continue,
+            Relation::Mixed => match front_part(&caster, &overlap, stats)? {
+                Some(hiding) => clip(&overlap.region, &hiding.region)?.outside,
+                None => overlap.region,
+            },
+        };
+        lit.rings.extend(kept.rings);
+    }
+    Ok(lit)
+}
+
+fn clip_error(e: ClipError) -> Error {
+    Error::Invalid(format!("atherton-weiler-greenberg: {e}"))
+}
+
+/// One view from the light: how world points map into its 2D coordinates.
+#[derive(Debug, Clone, Copy)]
+enum LightView {
+    /// A 90° face of the cube around a point light: `(u, v) = (p·e1, p·e2) / p·axis` with
+    /// `p` relative to the light.
+    Face { light: DVec3, axis: DVec3, e1: DVec3, e2: DVec3 },
+    /// Parallel to a directional light: `(u, v) = (p·e1, p·e2)`, depth `p·d`.
+    Parallel { d: DVec3, e1: DVec3, e2: DVec3 },
+}
+
+impl LightView {
+    fn views(sample: LightSample) -> Vec<LightView> {
+        match sample {
+            LightSample::Point(light) => [DVec3::X, DVec3::NEG_X, DVec3::Y, DVec3::NEG_Y, DVec3::Z, DVec3::NEG_Z]
+                .into_iter()
+                .map(|axis| {
+                    let e1 = axis.any_orthonormal_vector();
+                    LightView::Face { light, axis, e1, e2: axis.cross(e1) }
+                })
+                .collect(),
+            LightSample::Directional(d) => {
+                let e1 = d.any_orthonormal_vector();
+                vec![LightView::Parallel { d, e1, e2: d.cross(e1) }]
+            }
+        }
+    }
+
+    /// Polygon `verts` cut to this view (for a cube face, its frustum) and mapped into it,
+    /// with its nearness function; `None` when nothing is left or it is edge-on.
+    fn map(&self, verts: &[DVec3], plane: &Plane, near: f64) -> Option<(Vec<DVec2>, DepthPlane)> {
+        match *self {
+            LightView::Face { light, axis, e1, e2 } => {
+                let mut a: Vec<DVec3> = verts.iter().map(|&v| v - light).collect();
+                let mut b = Vec::new();
+                // The frustum |p·e1|, |p·e2| <= p·axis, and a tiny near plane at the light.
+                let planes: [&dyn Fn(DVec3) -> f64; 5] = [
+                    &|p| p.dot(axis) - p.dot(e1),
+                    &|p| p.dot(axis) + p.dot(e1),
+                    &|p| p.dot(axis) - p.dot(e2),
+                    &|p| p.dot(axis) + p.dot(e2),
+                    &|p| p.dot(axis) - near,
+                ];
+                for f in planes {
+                    if a.iter().any(|&p| f(p) < 0.0) {
+                        clip_polygon(&a, f, &mut b);
+                        std::mem::swap(&mut a, &mut b);
+                    }
+                }
+                if a.len() < 3 {
+                    return None;
+                }
+                // Nearness = 1 / (depth along the axis) of the plane's point seen at (u, v):
+                // the ray (axis + u e1 + v e2) t meets n·(light + ray t) + d = 0.
+                let k = plane.distance(light);
+                if k == 0.0 {
+                    return None;
+                }
+                let n = plane.n;
+                let near_fn = DepthPlane { a: -n.dot(e1) / k, b: -n.dot(e2) / k, c: -n.dot(axis) / k };
+                Some((a.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2)) / p.dot(axis)).collect(), near_fn))
+            }
+            LightView::Parallel { d, e1, e2 } => {
+                // The plane's point at (u, v) is u e1 + v e2 + s d with s = −(n·(u e1 + v e2) + d0)/(n·d);
+                // nearness is −s.
+                let nd = plane.n.dot(d);
+                if nd == 0.0 {
+                    return None;
+                }
+                let near_fn = DepthPlane { a: plane.n.dot(e1) / nd, b: plane.n.dot(e2) / nd, c: plane.d / nd };
+                Some((verts.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2))).collect(), near_fn))
+            }
+        }
+    }
+
+    /// The world point on `plane` that this view sees at `q`.
+    fn unmap(&self, q: DVec2, plane: &Plane) -> DVec3 {
+        match *self {
+            LightView::Face { light, axis, e1, e2 } => {
+                let ray = axis + e1 * q.x + e2 * q.y;
+                light + ray * (-plane.distance(light) / plane.n.dot(ray))
+            }
+            LightView::Parallel { d, e1, e2 } => {
+                let p = e1 * q.x + e2 * q.y;
+                p - d * (plane.distance(p) / plane.n.dot(d))
+            }
+        }
+    }
+}
+
+impl ShadowDatabase {
+    /// Pass 1 and the merge for light `light` of `scene`: every sample's lit detail polygons.
+    pub fn build(scene: &Scene, light: usize, counters: &mut Counters) -> Result<ShadowDatabase> {
+        let l = scene.lights.get(light).ok_or_else(|| Error::Invalid(format!("no light {light}")))?;
+        let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
+        let t = Instant::now();
+        let mut stats = Pass1::default();
+        let mut samples = Vec::new();
+        for sample in l.samples() {
+            let mut lit: Vec<DetailPolygon> = Vec::new();
+            for view in LightView::views(sample) {
+                let mut casters = Vec::new();
+                let mut others = Vec::new();
+                for (i, poly) in scene.polygons.iter().enumerate() {
+                    if edge_on(scene, i, sample, extent) {
+                        continue;
+                    }
+                    let Some((ring, near)) = view.map(scene.verts(i), &poly.plane, 1e-9 * extent) else { continue };
+                    let Some(piece) = Piece::new(i as u32, Region::from_ring(ring), near) else { continue };
+                    if scene.casts_shadows(i) {
+                        casters.push(piece);
+                    } else {
+                        others.push(piece);
+                    }
+                }
+                let seen = visible(casters.clone(), 0, &mut stats).map_err(clip_error)?;
+                // The pieces of a face split into a fan never shadow each other: their lit
+                // parts come from a sort without their sibling pieces.
+                let face = |p: &Piece| scene.polygons[p.source as usize].face;
+                let mut pieces_of: HashMap<u32, usize> = HashMap::new();
+                for c in &casters {
+                    *pieces_of.entry(face(c)).or_default() += 1;
+                }
+                let split = |p: &Piece| pieces_of.get(&face(p)).is_some_and(|&n| n > 1);
+                let mut pieces: Vec<Piece> = seen.iter().filter(|p| !split(p)).cloned().collect();
+                for p in casters.iter().filter(|p| split(p)) {
+                    let list = casters
+                        .iter()
+                        .filter(|q| q.source == p.source || (face(q) != face(p) && q.overlaps(p)))
+                        .cloned()
+                        .collect();
+                    let own = visible(list, 0, &mut stats).map_err(clip_error)?;
+                    pieces.extend(own.into_iter().filter(|v| v.source == p.source));
+                }
+                // Polygons that cast no shadow: lit where no visible caster lies in front.
+                for o in others {
+                    let lit = unshadowed(o.clone(), &seen, &mut stats).map_err(clip_error)?;
+                    pieces.extend(Piece::new(o.source, lit, o.near));
+                }
+                for p in pieces {
+                    let plane = scene.polygons[p.source as usize].plane;
+                    let rings =
+                        p.region.rings.iter().map(|r| r.iter().map(|&q| view.unmap(q, &plane)).collect()).collect();
+                    lit.push(DetailPolygon { source: p.source, rings });
+                }
+            }
+            samples.push(lit);
+        }
+        counters.add("light_space_fragments", stats.fragments);
+        counters.add("clip_operations", stats.clips);
+        counters.add("interpenetration_splits", stats.splits);
+        counters.add("area_sort_depth_max", stats.depth_max);
+        let detail: usize = samples.iter().map(Vec::len).sum();
+        let verts: usize = samples.iter().flatten().flat_map(|d| &d.rings).map(Vec::len).sum();
+        counters.add("detail_polygons", detail as u64);
+        counters.add("detail_vertices", verts as u64);
+        counters.add("pass1_us", t.elapsed().as_micros() as u64);
+        Ok(ShadowDatabase { samples })
+    }
+
+    /// Writes the database as an OBJ file: one group per detail polygon, named after its
+    /// light sample and the face id of its source polygon (`g sample<s>_face<id>`); holes are
+    /// separate faces of the same group.
+    pub fn write_obj(&self, scene: &Scene, path: &Path) -> Result<()> {
+        let mut out = String::from("# umbra: Atherton-Weiler-Greenberg lit detail polygons\n");
+        let mut next = 1;
+        for (s, polys) in self.samples.iter().enumerate() {
+            for d in polys {
+                let _ = writeln!(out, "g sample{s}_face{}", scene.polygons[d.source as usize].face);
+                for ring in &d.rings {
+                    for v in ring {
+                        let _ = writeln!(out, "v {:?} {:?} {:?}", v.x, v.y, v.z);
+                    }
+                    let ids: Vec<String> = (next..next + ring.len()).map(|i| i.to_string()).collect();
+                    let _ = writeln!(out, "f {}", ids.join(" "));
+                    next += ring.len();
+                }
+            }
+        }
+        std::fs::write(path, out).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+    }
+}
+
+/// The prepared stage: each sample's detail polygons in screen space.
+pub struct AthertonWeilerGreenberg<'a> {
+    ctx: &'a ShadowContext<'a>,
+    detail: Vec<Overlay>,
+}
+
+impl<'a> AthertonWeilerGreenberg<'a> {
+    /// Builds the databases (or takes the ones in the options) and puts their detail polygons
+    /// through the camera.
+    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Result<Self> {
+        let databases: Arc<Vec<ShadowDatabase>> = match &ctx.options.awg_database {
+            Some(db) if db.len() == ctx.scene.lights.len() => db.clone(),
+            Some(_) => return Err(Error::Invalid("the shadow database does not match the scene's lights".into())),
+            None => Arc::new(
+                (0..ctx.scene.lights.len())
+                    .map(|l| ShadowDatabase::build(ctx.scene, l, counters))
+                    .collect::<Result<_>>()?,
+            ),
+        };
+        let view = ctx.view;
+        let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
+        let mut detail = Vec::new();
+        for db in databases.iter() {
+            for polys in &db.samples {
+                let mut overlay = Overlay::new(view.height, ctx.options.keep_outlines);
+                for d in polys.iter().filter(|d| ctx.visible[d.source as usize]) {
+                    let mut rings = Vec::new();
+                    for r in &d.rings {
+                        if view.clip_project(r, &mut scratch, &mut ring) {
+                            rings.push(ring.clone());
+                        }
+                    }
+                    if !rings.is_empty() {
+                        overlay.add_rings(d.source, &rings);
+                    }
+                }
+                overlay.finish();
+                counters.add("detail_polygons_in_view", overlay.len() as u64);
+                detail.push(overlay);
+            }
+        }
+        Ok(AthertonWeilerGreenberg { ctx, detail })
+    }
+}
+
+impl ShadowStage for AthertonWeilerGreenberg<'_> {
+    fn walker(&self) -> Box<dyn ShadowWalker + '_> {
+        Box::new(Walker {
+            stage: self,
+            walkers: self.detail.iter().map(|o| o.walker(0..self.ctx.view.height)).collect(),
+            intervals: Vec::new(),
+        })
+    }
+
+    fn outlines(&self) -> Vec<Vec<DVec2>> {
+        self.detail.first().map_or_else(Vec::new, |o| o.rings().to_vec())
+    }
+}
+
+struct Walker<'s> {
+    stage: &'s AthertonWeilerGreenberg<'s>,
+    walkers: Vec<OverlayWalker<'s>>,
+    intervals: Vec<Interval>,
+}
+
+impl ShadowWalker for Walker<'_> {
+    fn start_line(&mut self, line: u32) {
+        for w in &mut self.walkers {
+            w.advance_to(line);
+        }
+    }
+
+    fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
+        lit.fill(0.0);
+        let k = self.stage.ctx.sample_index(light, sample);
+        self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut self.intervals);
+        for iv in &self.intervals {
+            lit[(iv.start - run.x0) as usize..(iv.end - run.x0) as usize].fill(1.0);
+        }
+    }
+}
