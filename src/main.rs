@@ -24,6 +24,21 @@ enum Command {
     Render(RenderArgs),
     /// Write a generated benchmark scene (scene file plus OBJ meshes).
     Generate(GenerateArgs),
+    /// Build the Atherton-Weiler-Greenberg shadow database of a light (its lit detail
+    /// polygons, independent of the camera) and write it as an OBJ file.
+    ExportShadows(ExportArgs),
+}
+
+#[derive(clap::Args)]
+struct ExportArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// Where to write the OBJ file.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Which light (0-based, in file order).
+    #[arg(long, default_value_t = 0)]
+    light: usize,
 }
 
 #[derive(clap::Args)]
@@ -192,6 +207,12 @@ fn run(cli: Cli) -> umbra::Result<()> {
                 println!("{}", serde_json::to_string(&out.stats).map_err(|e| umbra::Error::Invalid(e.to_string()))?);
             }
             Ok(())
+        }
+        Command::ExportShadows(e) => {
+            let scene = Scene::load(&e.scene)?;
+            let mut counters = umbra::Counters::default();
+            let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, &mut counters)?;
+            db.write_obj(&scene, &e.output)
         }
         Command::Generate(g) => {
             let scene = match g.family {

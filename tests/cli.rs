@@ -74,3 +74,16 @@ fn generate_writes_a_loadable_scene() {
     let direct = umbra::generate::cubes(2, true, 64, 48).unwrap();
     assert_eq!(s.vertices, direct.vertices, "written and generated scenes are the same");
 }
+
+#[test]
+fn export_shadows_writes_an_obj_of_lit_detail_polygons() {
+    let d = tmp("export");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml");
+    let out = umbra().args(["export-shadows", scene, "-o"]).arg(d.join("lit.obj")).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(d.join("lit.obj")).unwrap();
+    let mesh = umbra::scene::parse_obj(&text, std::path::Path::new("lit.obj")).unwrap();
+    assert!(mesh.faces.len() > 10);
+    // Every group names the source face it lies on.
+    assert!(text.lines().filter(|l| l.starts_with("g sample0_face")).count() >= 10);
+}

@@ -143,3 +143,29 @@ fn naive_zpass_fails_when_the_eye_is_in_shadow() {
     assert!(wrong > 5000, "naive z-pass should fail over the roof's shadow, {wrong} pixels differ");
     assert_eq!(wrong, wrong_lit_floor, "every error is floor in the roof's shadow counted lit");
 }
+
+/// The Atherton-Weiler-Greenberg database does not depend on the camera: built once, it
+/// renders any view exactly as building it for that view does.
+#[test]
+fn one_shadow_database_serves_many_views() {
+    use std::sync::Arc;
+    use umbra::shadow::ShadowDatabase;
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/lights.toml");
+    let mut scene = load_scaled(&path, 200);
+    let mut counters = umbra::Counters::default();
+    let db: Vec<ShadowDatabase> =
+        (0..scene.lights.len()).map(|l| ShadowDatabase::build(&scene, l, &mut counters).unwrap()).collect();
+    let db = Arc::new(db);
+    for eye in [glam::DVec3::new(0.0, 5.0, 8.5), glam::DVec3::new(-6.0, 3.0, 2.0), glam::DVec3::new(4.0, 6.0, -5.0)] {
+        scene.camera.eye = eye;
+        let fresh = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg);
+        let options = umbra::shadow::ShadowOptions { awg_database: Some(db.clone()), ..Default::default() };
+        let reused = frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg, options);
+        assert_eq!(fresh.light, reused.light, "view from {eye}");
+        assert_light_agree(
+            &frame(&scene, VisibilityMethod::RayCast, ShadowMethod::RayCast),
+            &reused,
+            &format!("view from {eye}"),
+        );
+    }
+}

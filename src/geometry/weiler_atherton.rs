@@ -34,7 +34,7 @@
 
 use super::inside_even_odd;
 use glam::DVec2;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 /// A closed polygon outline.
 pub type Ring = Vec<DVec2>;
@@ -176,24 +176,32 @@ pub fn clip(subject: &Region, clip: &Region) -> Result<Clipped, ClipError> {
     if !finite(subject) || !finite(clip) {
         return Err(ClipError::NonFinite);
     }
-    let (lo, hi) = subject
-        .rings
-        .iter()
-        .chain(&clip.rings)
-        .flatten()
-        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    let eps = 1e-9 * (hi - lo).length().max(1e-300);
-    // Rings with no area (slivers, lines walked there and back) bound nothing: drop them.
-    let solid =
-        |r: &Region| Region { rings: r.rings.iter().filter(|x| signed_area(x).abs() > eps * eps).cloned().collect() };
-    let (s_rings, c_rings) = (oriented(&solid(subject)), oriented(&solid(clip)));
-    if s_rings.is_empty() {
-        return Ok(Clipped::default());
+    let (Some(sb), Some(cb)) = (subject.bounds(), clip.bounds()) else {
+        return Ok(Clipped { inside: Region::default(), outside: subject.clone() });
+    };
+    let eps = 1e-9 * (sb.1.max(cb.1) - sb.0.min(cb.0)).length().max(1e-300);
+    let ring_box =
+        |r: &Ring| r.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let meets = |r: &Ring, b: (DVec2, DVec2)| {
+        let (lo, hi) = ring_box(r);
+        lo.x <= b.1.x + eps && b.0.x <= hi.x + eps && lo.y <= b.1.y + eps && b.0.y <= hi.y + eps
+    };
+    // A ring whose box misses the other region's box cannot change anything inside that box
+    // (by the even-odd rule): subject rings there pass to the outside part untouched, clip
+    // rings there are dropped. Rings with no area (slivers, lines walked there and back)
+    // bound nothing and are dropped too.
+    let solid = |r: &Ring| signed_area(r).abs() > eps * eps;
+    let (near, far): (Vec<Ring>, Vec<Ring>) =
+        subject.rings.iter().filter(|r| solid(r)).cloned().partition(|r| meets(r, cb));
+    let c_near: Vec<Ring> = clip.rings.iter().filter(|r| solid(r) && meets(r, sb)).cloned().collect();
+    let (s_rings, c_rings) = (oriented(&Region { rings: near }), oriented(&Region { rings: c_near }));
+    if s_rings.is_empty() || c_rings.is_empty() {
+        return Ok(Clipped {
+            inside: Region::default(),
+            outside: Region { rings: s_rings.into_iter().chain(far).collect() },
+        });
     }
-    if c_rings.is_empty() {
-        return Ok(Clipped { inside: Region::default(), outside: Region { rings: s_rings } });
-    }
-    let mut verts = Vertices { pts: Vec::new(), grid: HashMap::new(), eps };
+    let mut verts = Vertices { pts: Vec::new(), grid: HashMap::default(), eps };
     let edges_of = |rings: &[Ring], verts: &mut Vertices| -> Vec<Edge> {
         let mut out = Vec::new();
         for ring in rings {
@@ -207,27 +215,23 @@ pub fn clip(subject: &Region, clip: &Region) -> Result<Clipped, ClipError> {
         }
         out
     };
-    let mut se = edges_of(&s_rings, &mut verts);
-    let mut ce = edges_of(&c_rings, &mut verts);
+    let se = edges_of(&s_rings, &mut verts);
+    let ce = edges_of(&c_rings, &mut verts);
 
     // Step 1: split both regions' edges wherever they meet, each other's and their own (a
-    // ring cut by Sutherland-Hodgman can run back along itself: a zero-width bridge).
-    for edges in [&mut se, &mut ce] {
-        for i in 0..edges.len() {
-            let (head, tail) = edges.split_at_mut(i + 1);
-            for f in tail {
-                split_pair(&mut head[i], f, &mut verts);
-            }
-        }
+    // ring cut by Sutherland-Hodgman can run back along itself: a zero-width bridge). Only
+    // edges whose boxes overlap can meet: a sweep along x finds them.
+    let n_s = se.len();
+    let mut all: Vec<Edge> = se.into_iter().chain(ce).collect();
+    for (i, j) in overlapping_pairs(&all, &verts.pts, eps) {
+        let (head, tail) = all.split_at_mut(j);
+        split_pair(&mut head[i], &mut tail[0], &mut verts);
     }
-    for e in se.iter_mut() {
-        for f in ce.iter_mut() {
-            split_pair(e, f, &mut verts);
-        }
-    }
+    let ce = all.split_off(n_s);
+    let se = all;
     // Sub-edges, with pieces that run both ways within one region (bridges) cancelled.
     let pieces = |edges: &[Edge]| -> Vec<(u32, u32)> {
-        let mut count: HashMap<(u32, u32), i32> = HashMap::new();
+        let mut count: HashMap<(u32, u32), i32> = HashMap::default();
         let mut order = Vec::new();
         for e in edges {
             let mut s = e.splits.clone();
@@ -295,7 +299,36 @@ pub fn clip(subject: &Region, clip: &Region) -> Result<Clipped, ClipError> {
     }
 
     // Step 3: trace.
-    Ok(Clipped { inside: trace(pts, &inside, eps)?, outside: trace(pts, &outside, eps)? })
+    let mut outside = trace(pts, &outside, eps)?;
+    outside.rings.extend(far);
+    Ok(Clipped { inside: trace(pts, &inside, eps)?, outside })
+}
+
+/// The pairs `(i, j)`, `i < j`, of edges whose bounding boxes (grown by `eps`) overlap: a
+/// sweep over the boxes sorted by their left side.
+fn overlapping_pairs(edges: &[Edge], pts: &[DVec2], eps: f64) -> Vec<(usize, usize)> {
+    let boxes: Vec<(DVec2, DVec2)> = edges
+        .iter()
+        .map(|e| {
+            let (a, b) = (pts[e.a as usize], pts[e.b as usize]);
+            (a.min(b) - DVec2::splat(eps), a.max(b) + DVec2::splat(eps))
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..edges.len()).collect();
+    order.sort_unstable_by(|&i, &j| boxes[i].0.x.total_cmp(&boxes[j].0.x));
+    let mut active: Vec<usize> = Vec::new();
+    let mut pairs = Vec::new();
+    for &i in &order {
+        let (lo, hi) = boxes[i];
+        active.retain(|&k| boxes[k].1.x >= lo.x);
+        for &k in &active {
+            if boxes[k].0.y <= hi.y && lo.y <= boxes[k].1.y {
+                pairs.push((i.min(k), i.max(k)));
+            }
+        }
+        active.push(i);
+    }
+    pairs
 }
 
 /// Splits edges `e` and `f` where they meet. One set of predicates decides everything: the
@@ -344,8 +377,8 @@ fn split_pair(e: &mut Edge, f: &mut Edge, verts: &mut Vertices) {
 /// Closes directed edges into rings: at each vertex the next edge is the unused one that
 /// turns furthest left. An error when edges do not balance at some vertex.
 pub(crate) fn trace(pts: &[DVec2], edges: &[(u32, u32)], eps: f64) -> Result<Region, ClipError> {
-    let mut out_of: HashMap<u32, Vec<usize>> = HashMap::new();
-    let mut into: HashMap<u32, usize> = HashMap::new();
+    let mut out_of: HashMap<u32, Vec<usize>> = HashMap::default();
+    let mut into: HashMap<u32, usize> = HashMap::default();
     for (i, &(a, b)) in edges.iter().enumerate() {
         out_of.entry(a).or_default().push(i);
         *into.entry(b).or_default() += 1;

@@ -138,31 +138,58 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
 
 /// Weiler & Atherton's hidden-surface removal by area sorting: the parts of `list` that
 /// nothing in the list hides.
-fn visible(mut list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
+///
+/// Pieces wait in a heap in rough depth order (nearest vertex first; what is left of a piece
+/// after a clip keeps its place) and sit in a uniform grid over their bounding boxes, so that
+/// the front polygon meets only the pieces it may overlap.
+fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
     stats.depth_max = stats.depth_max.max(depth);
-    // The rough depth sort: nearest vertex first.
-    list.sort_by(|a, b| b.nearest().total_cmp(&a.nearest()));
+    let Some((lo, hi)) = list.iter().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else {
+        return Ok(Vec::new());
+    };
+    let g = ((list.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
+    let size = (hi - lo).max(DVec2::splat(1e-300));
+    let cells_of = |b: (DVec2, DVec2)| {
+        let cell = |v: f64, lo: f64, size: f64| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
+        let (c0, c1) = (cell(b.0.x, lo.x, size.x), cell(b.1.x, lo.x, size.x));
+        let (r0, r1) = (cell(b.0.y, lo.y, size.y), cell(b.1.y, lo.y, size.y));
+        (c0..=c1).flat_map(move |c| (r0..=r1).map(move |r| c * g + r))
+    };
+    let mut grid: Vec<Vec<u32>> = vec![Vec::new(); g * g];
+    let mut arena: Vec<Option<Piece>> = Vec::new();
+    let mut heap = std::collections::BinaryHeap::new();
+    for p in list {
+        let i = arena.len() as u32;
+        for c in cells_of(p.bounds) {
+            grid[c].push(i);
+        }
+        // Max-heap: nearest first, then first added.
+        heap.push((OrdF64(p.nearest()), std::cmp::Reverse(i)));
+        arena.push(Some(p));
+    }
     let mut out = Vec::new();
-    let mut list = std::collections::VecDeque::from(list);
-    while let Some(front) = list.pop_front() {
+    let mut seen_stamp: Vec<u32> = vec![u32::MAX; arena.len()];
+    while let Some((_, std::cmp::Reverse(fi))) = heap.pop() {
+        let Some(front) = arena[fi as usize].take() else { continue };
         // The front polygon's outline splits everything it overlaps into inside and outside.
         let mut inside = Vec::new();
-        let mut rest = std::collections::VecDeque::with_capacity(list.len());
-        for q in list.drain(..) {
-            if !q.overlaps(&front) {
-                rest.push_back(q);
-                continue;
-            }
+        let candidates: Vec<u32> = cells_of(front.bounds)
+            .flat_map(|c| grid[c].iter().copied())
+            .filter(|&q| {
+                let fresh = seen_stamp[q as usize] != fi;
+                seen_stamp[q as usize] = fi;
+                fresh && arena[q as usize].as_ref().is_some_and(|p| p.overlaps(&front))
+            })
+            .collect();
+        for q in candidates {
+            let Some(piece) = arena[q as usize].take() else { continue };
             stats.clips += 1;
-            let c = clip(&q.region, &front.region)?;
-            if let Some(p) = Piece::new(q.source, c.inside, q.near) {
-                inside.push(p);
-            }
-            if let Some(p) = Piece::new(q.source, c.outside, q.near) {
-                rest.push_back(p);
-            }
+            let c = clip(&piece.region, &front.region)?;
+            inside.extend(Piece::new(piece.source, c.inside, piece.near));
+            // The outside part takes its parent's place: in the grid (it only shrank) and in
+            // the order.
+            arena[q as usize] = Piece::new(piece.source, c.outside, piece.near);
         }
-        list = rest;
         // Inside: hidden where behind the front polygon; where in front, the sort was wrong.
         let mut fronts = Vec::new();
         for q in inside {
@@ -191,6 +218,24 @@ fn visible(mut list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::
     }
     stats.fragments += out.len() as u64;
     Ok(out)
+}
+
+/// An f64 ordered by `total_cmp`, for the heap.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OrdF64(f64);
+
+impl Eq for OrdF64 {}
+
+impl PartialOrd for OrdF64 {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for OrdF64 {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
 }
 
 /// The part of `o` (a polygon that casts no shadow) that no visible caster piece in `seen`
