@@ -21,13 +21,33 @@ pub struct Frame {
     pub id: Vec<u32>,
     /// `light[k][pixel]`: lit fraction of light `k` at the visible point (0 on background).
     pub light: Vec<Vec<f32>>,
+    /// Per-pixel counters, when the render was asked for them.
+    pub counters: Option<PixelCounters>,
+}
+
+/// Per-pixel counters (`--aov` writes them as false-colour images).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PixelCounters {
+    /// Screen polygons covering the pixel centre (before hidden-surface removal).
+    pub depth_complexity: Vec<u32>,
+    /// How many times Watkins' algorithm split the span holding the pixel.
+    pub span_splits: Vec<u32>,
+    /// Shadow-stage polygons (or texels, or rays) tested for the pixel, over all samples.
+    pub shadow_tests: Vec<u32>,
 }
 
 impl Frame {
     /// A frame of background pixels.
     pub fn new(width: u32, height: u32, lights: usize, background: Vec3) -> Frame {
         let n = width as usize * height as usize;
-        Frame { width, height, color: vec![background; n], id: vec![BACKGROUND; n], light: vec![vec![0.0; n]; lights] }
+        Frame {
+            width,
+            height,
+            color: vec![background; n],
+            id: vec![BACKGROUND; n],
+            light: vec![vec![0.0; n]; lights],
+            counters: None,
+        }
     }
 
     fn save(&self, img: image::DynamicImage, path: &Path) -> Result<()> {
@@ -96,12 +116,24 @@ impl Frame {
         self.save(self.color_image(gamma).into(), path)
     }
 
-    /// Writes `id.png` and `light<k>.png` into `dir` (created if missing).
+    /// Writes `id.png` and `light<k>.png` into `dir` (created if missing), and, when the
+    /// frame has per-pixel counters, `depth_complexity.png`, `span_splits.png` and
+    /// `shadow_tests.png` in false colour with a legend.
     pub fn save_aovs(&self, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|e| Error::Io { path: dir.to_owned(), source: e })?;
         self.save(self.id_image().into(), &dir.join("id.png"))?;
         for k in 0..self.light.len() {
             self.save(self.light_image(k).into(), &dir.join(format!("light{k}.png")))?;
+        }
+        if let Some(c) = &self.counters {
+            for (name, values) in [
+                ("depth_complexity", &c.depth_complexity),
+                ("span_splits", &c.span_splits),
+                ("shadow_tests", &c.shadow_tests),
+            ] {
+                let img = crate::study::false_colour::image(values, self.width, self.height);
+                self.save(img.into(), &dir.join(format!("{name}.png")))?;
+            }
         }
         Ok(())
     }

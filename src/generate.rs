@@ -299,3 +299,33 @@ pub fn random(seed: u64, opts: RandomOptions) -> Result<Scene> {
         vec![object(0, Mesh::from_polygons(&polys))],
     )
 }
+
+/// `n` random triangles with edges about `size` long, scattered through a cube of side 4 —
+/// uniformly, or clustered around its centre — over a floor, for Slater et al.'s study of
+/// polygon count, size and distribution.
+pub fn scattered(n: u32, size: f64, clustered: bool, width: u32, height: u32) -> Result<Scene> {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let mut tris = Vec::with_capacity(n as usize);
+    for _ in 0..n {
+        let c = if clustered {
+            // A rough normal distribution: the mean of three uniforms.
+            DVec3::new(
+                (0..3).map(|_| rng.gen_range(-2.0..2.0)).sum::<f64>() / 3.0,
+                (0..3).map(|_| rng.gen_range(0.0..4.0)).sum::<f64>() / 3.0,
+                (0..3).map(|_| rng.gen_range(-2.0..2.0)).sum::<f64>() / 3.0,
+            )
+        } else {
+            DVec3::new(rng.gen_range(-2.0..2.0), rng.gen_range(0.0..4.0), rng.gen_range(-2.0..2.0))
+        };
+        let mut corner =
+            || c + DVec3::new(rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)) * size;
+        tris.push(vec![corner(), corner(), corner()]);
+    }
+    Scene::new(
+        camera(DVec3::new(0.0, 3.0, 8.0), DVec3::new(0.0, 1.5, 0.0), width, height),
+        RenderSettings::default(),
+        vec![material("floor", [0.8, 0.8, 0.8]), material("tri", [0.5, 0.7, 0.9])],
+        vec![point_light(DVec3::new(-3.0, 8.0, 4.0))],
+        vec![object(0, floor(4.0)), object(1, Mesh::from_polygons(&tris))],
+    )
+}

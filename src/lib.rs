@@ -45,6 +45,7 @@ pub mod scene;
 pub mod shading;
 pub mod shadow;
 pub mod stats;
+pub mod study;
 pub mod view;
 pub mod visibility;
 

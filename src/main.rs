@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use umbra::shadow::volumes::Counting;
 use umbra::shadow::{ShadowFilter, ShadowOptions, WilliamsOptions};
-use umbra::{generate, render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
+use umbra::study::compare::{compare, CompareOptions};
+use umbra::study::scale::{scale, ScaleOptions, Sweep};
+use umbra::{generate, render, Error, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 #[derive(Parser)]
 #[command(
@@ -22,6 +24,13 @@ struct Cli {
 enum Command {
     /// Render a scene file to a PNG.
     Render(RenderArgs),
+    /// Render a scene with every visibility × shadow combination, measure each against the
+    /// ray-cast reference, and write report.html, results.json and results.csv.
+    Compare(CompareArgs),
+    /// Sweep a generated scene family over a parameter and plot time and a counter.
+    Scale(ScaleArgs),
+    /// Show what Watkins' algorithm and a shadow stage did on one scanline.
+    Trace(TraceArgs),
     /// Write a generated benchmark scene (scene file plus OBJ meshes).
     Generate(GenerateArgs),
     /// Build the Atherton-Weiler-Greenberg shadow database of a light (its lit detail
@@ -29,49 +38,16 @@ enum Command {
     ExportShadows(ExportArgs),
 }
 
+/// Options of the shadow stages, shared by every command that renders.
 #[derive(clap::Args)]
-struct ExportArgs {
-    /// The scene file.
-    scene: PathBuf,
-    /// Where to write the OBJ file.
-    #[arg(short, long)]
-    output: PathBuf,
-    /// Which light (0-based, in file order).
-    #[arg(long, default_value_t = 0)]
-    light: usize,
-}
-
-#[derive(clap::Args)]
-struct RenderArgs {
-    /// The scene file (TOML, see SCENE_FORMAT.md).
-    scene: PathBuf,
-    /// Where to write the image (PNG).
-    #[arg(short, long, default_value = "out.png")]
-    output: PathBuf,
-    /// Hidden-surface stage: scanline (Watkins), zbuffer, or ray-cast (one ray per pixel).
-    #[arg(long, default_value = "scanline", value_parser = parse_visibility)]
-    visibility: VisibilityMethod,
-    /// Shadow stage. Exact: bouknight-kelley (projected shadow polygons), crow (shadow
-    /// volumes counted per span), stencil-volume (the same volumes counted per pixel),
-    /// ray-cast (per-pixel reference). Approximate: williams (shadow maps), planar (Blinn's
-    /// projection onto receiver planes). Or none. The default is the recommended exact method.
-    #[arg(long, default_value = ShadowMethod::DEFAULT.name(), value_parser = parse_shadows)]
-    shadows: ShadowMethod,
-    /// Write the analysis buffers id.png and light<k>.png into this folder.
-    #[arg(long, value_name = "DIR")]
-    aov: Option<PathBuf>,
-    /// Print the counters and times as one JSON object on standard output.
-    #[arg(long)]
-    stats: bool,
-    /// Encode the image with this display gamma (for example 2.2); default: linear values.
-    #[arg(long)]
-    gamma: Option<f32>,
+struct ShadowArgs {
     /// Bouknight-Kelley: project every pair, without the sphere prefilter (to measure it).
     #[arg(long)]
     no_prefilter: bool,
-    /// Crow: count shadow volumes from the eye with the eye's own count (zpass), from
-    /// infinity (zfail), or from zero at the eye (naive-zpass, wrong when the eye is in shadow).
-    #[arg(long, default_value = "zpass", value_parser = parse_count)]
+    /// Crow and stencil-volume: count shadow volumes from the eye with the eye's own count
+    /// (zpass), from infinity (zfail), or from zero at the eye (naive-zpass, wrong when the
+    /// eye is in shadow).
+    #[arg(long, default_value = "zpass", value_parser = parse::<Counting>)]
     crow_count: Counting,
     /// Williams: texels along each side of a shadow map.
     #[arg(long, default_value_t = 2048)]
@@ -92,10 +68,144 @@ struct RenderArgs {
     /// Williams: leave polygons facing the light out of the depth map (seed 003).
     #[arg(long)]
     cull_front: bool,
+}
+
+impl ShadowArgs {
+    fn options(&self, keep_outlines: bool) -> umbra::Result<ShadowOptions> {
+        if self.map_size == 0 || self.map_size > 16384 || self.pcf_size % 2 == 0 {
+            return Err(Error::Invalid("--map-size must be 1..=16384 and --pcf-size odd".into()));
+        }
+        let filter = match self.shadow_filter {
+            FilterArg::Nearest => ShadowFilter::Nearest,
+            FilterArg::Pcf => ShadowFilter::Pcf(self.pcf_size),
+            FilterArg::SoftEdge => ShadowFilter::SoftEdge(self.pcf_size),
+        };
+        Ok(ShadowOptions {
+            prefilter: !self.no_prefilter,
+            crow_count: self.crow_count,
+            williams: WilliamsOptions {
+                map_size: self.map_size,
+                bias: self.bias,
+                slope_bias: self.slope_bias,
+                filter,
+                cull_front: self.cull_front,
+            },
+            awg_database: None,
+            keep_outlines,
+        })
+    }
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// The scene file (TOML, see SCENE_FORMAT.md).
+    scene: PathBuf,
+    /// Where to write the image (PNG).
+    #[arg(short, long, default_value = "out.png")]
+    output: PathBuf,
+    /// Hidden-surface stage: scanline (Watkins), zbuffer, or ray-cast (one ray per pixel).
+    #[arg(long, default_value = "scanline", value_parser = parse::<VisibilityMethod>)]
+    visibility: VisibilityMethod,
+    /// Shadow stage. Exact: bouknight-kelley (projected shadow polygons),
+    /// atherton-weiler-greenberg (hidden-surface removal from the light), crow (shadow volumes
+    /// counted per span), stencil-volume (the same volumes counted per pixel), ray-cast
+    /// (per-pixel reference). Approximate: williams (shadow maps), planar (Blinn's projection
+    /// onto receiver planes). Or none. The default is the recommended exact method.
+    #[arg(long, default_value = ShadowMethod::DEFAULT.name(), value_parser = parse::<ShadowMethod>)]
+    shadows: ShadowMethod,
+    #[command(flatten)]
+    shadow: ShadowArgs,
+    /// Write the analysis buffers id.png and light<k>.png into this folder, with per-pixel
+    /// counters in false colour: depth_complexity.png, span_splits.png, shadow_tests.png.
+    #[arg(long, value_name = "DIR")]
+    aov: Option<PathBuf>,
+    /// Print the counters and times as one JSON object on standard output.
+    #[arg(long)]
+    stats: bool,
+    /// Encode the image with this display gamma (for example 2.2); default: linear values.
+    #[arg(long)]
+    gamma: Option<f32>,
     /// Draw the shadow stage's own polygons for the first light sample over the image
-    /// (shadow-polygons: Bouknight-Kelley's projections on their receivers).
+    /// (shadow polygons, lit detail polygons, shadow-volume polygons).
     #[arg(long, value_enum)]
     debug: Option<Debug>,
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// Comma-separated visibility stages (default: all).
+    #[arg(long, value_delimiter = ',', value_parser = parse::<VisibilityMethod>)]
+    visibility: Vec<VisibilityMethod>,
+    /// Comma-separated shadow stages (default: all).
+    #[arg(long, value_delimiter = ',', value_parser = parse::<ShadowMethod>)]
+    shadows: Vec<ShadowMethod>,
+    /// Output folder.
+    #[arg(long, default_value = "compare")]
+    out: PathBuf,
+    /// Timed runs per method; the median is reported.
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    #[command(flatten)]
+    shadow: ShadowArgs,
+}
+
+#[derive(clap::Args)]
+struct ScaleArgs {
+    /// What to sweep: cubes (N per side), quads (depth complexity), spheres (triangles),
+    /// scattered / clustered (triangle count), size (triangle size), resolution (width).
+    #[arg(long, value_parser = parse::<Sweep>)]
+    sweep: Sweep,
+    /// Comma-separated values of the parameter.
+    #[arg(long, value_delimiter = ',', required = true)]
+    values: Vec<f64>,
+    /// Comma-separated methods as visibility:shadows (default: scanline:none,zbuffer:none).
+    #[arg(long, value_delimiter = ',', value_parser = parse_method)]
+    methods: Vec<(VisibilityMethod, ShadowMethod)>,
+    /// Counter to plot besides time: visibility.NAME or shadow.NAME.
+    #[arg(long, default_value = "visibility.depth_tests")]
+    counter: String,
+    /// Output folder.
+    #[arg(long, default_value = "scale")]
+    out: PathBuf,
+    /// Timed runs per point; the median is reported.
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Image width.
+    #[arg(long, default_value_t = 1920)]
+    width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 1080)]
+    height: u32,
+    /// Spheres (spheres sweep) or triangles (size sweep).
+    #[arg(long, default_value_t = 100)]
+    count: u32,
+    /// Triangle size (scattered and clustered sweeps).
+    #[arg(long, default_value_t = 0.3)]
+    size: f64,
+    #[command(flatten)]
+    shadow: ShadowArgs,
+}
+
+#[derive(clap::Args)]
+struct TraceArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// The scanline (0 at the top).
+    #[arg(long)]
+    line: u32,
+    /// Only the spans, runs and decisions covering this pixel.
+    #[arg(long)]
+    x: Option<u32>,
+    /// Shadow stage whose decisions to show.
+    #[arg(long, default_value = ShadowMethod::DEFAULT.name(), value_parser = parse::<ShadowMethod>)]
+    shadows: ShadowMethod,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    shadow: ShadowArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -154,57 +264,113 @@ struct GenerateArgs {
     height: u32,
 }
 
-fn parse_visibility(s: &str) -> Result<VisibilityMethod, String> {
-    s.parse().map_err(|e: umbra::Error| e.to_string())
+#[derive(clap::Args)]
+struct ExportArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// Where to write the OBJ file.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Which light (0-based, in file order).
+    #[arg(long, default_value_t = 0)]
+    light: usize,
 }
 
-fn parse_count(s: &str) -> Result<Counting, String> {
-    s.parse().map_err(|e: umbra::Error| e.to_string())
+fn parse<T: std::str::FromStr<Err = Error>>(s: &str) -> Result<T, String> {
+    s.parse().map_err(|e: Error| e.to_string())
 }
 
-fn parse_shadows(s: &str) -> Result<ShadowMethod, String> {
-    s.parse().map_err(|e: umbra::Error| e.to_string())
+fn parse_method(s: &str) -> Result<(VisibilityMethod, ShadowMethod), String> {
+    let (v, sh) = s.split_once(':').ok_or_else(|| format!("'{s}' is not visibility:shadows"))?;
+    Ok((parse(v)?, parse(sh)?))
+}
+
+fn scene_name(path: &std::path::Path) -> String {
+    path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned())
 }
 
 fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
             let scene = Scene::load(&a.scene)?;
-            let filter = match a.shadow_filter {
-                FilterArg::Nearest => ShadowFilter::Nearest,
-                FilterArg::Pcf => ShadowFilter::Pcf(a.pcf_size),
-                FilterArg::SoftEdge => ShadowFilter::SoftEdge(a.pcf_size),
+            let opts = RenderOptions {
+                visibility: a.visibility,
+                shadows: a.shadows,
+                shadow_options: a.shadow.options(a.debug.is_some())?,
+                progress: true,
+                pixel_counters: a.aov.is_some(),
             };
-            if a.map_size == 0 || a.map_size > 16384 || a.pcf_size % 2 == 0 {
-                return Err(umbra::Error::Invalid("--map-size must be 1..=16384 and --pcf-size odd".into()));
-            }
-            let williams = WilliamsOptions {
-                map_size: a.map_size,
-                bias: a.bias,
-                slope_bias: a.slope_bias,
-                filter,
-                cull_front: a.cull_front,
-            };
-            let shadow_options = ShadowOptions {
-                prefilter: !a.no_prefilter,
-                crow_count: a.crow_count,
-                williams,
-                awg_database: None,
-                keep_outlines: a.debug.is_some(),
-            };
-            let opts = RenderOptions { visibility: a.visibility, shadows: a.shadows, shadow_options, progress: true };
             let out = render(&scene, &opts)?;
             let mut img = out.frame.color_image(a.gamma);
             if a.debug.is_some() {
                 umbra::Frame::draw_outlines(&mut img, &out.outlines, [255, 40, 200]);
             }
             img.save_with_format(&a.output, image::ImageFormat::Png)
-                .map_err(|e| umbra::Error::Image { path: a.output.clone(), source: e })?;
+                .map_err(|e| Error::Image { path: a.output.clone(), source: e })?;
             if let Some(dir) = &a.aov {
                 out.frame.save_aovs(dir)?;
             }
             if a.stats {
-                println!("{}", serde_json::to_string(&out.stats).map_err(|e| umbra::Error::Invalid(e.to_string()))?);
+                println!("{}", serde_json::to_string(&out.stats).map_err(|e| Error::Invalid(e.to_string()))?);
+            }
+            Ok(())
+        }
+        Command::Compare(a) => {
+            let scene = Scene::load(&a.scene)?;
+            let d = CompareOptions::default();
+            let opts = CompareOptions {
+                visibility: if a.visibility.is_empty() { d.visibility } else { a.visibility },
+                shadows: if a.shadows.is_empty() { d.shadows } else { a.shadows },
+                shadow_options: a.shadow.options(false)?,
+                runs: a.runs,
+                out: a.out.clone(),
+                progress: true,
+            };
+            let report = compare(&scene, &scene_name(&a.scene), &opts)?;
+            for r in &report.results {
+                eprintln!(
+                    "{:>9} + {:<26} {:>9.1} ms  {:>8} / {:<8} wrong  {}",
+                    r.visibility, r.shadows, r.time_ms, r.wrong_pixels, r.interior_pixels, r.status
+                );
+            }
+            eprintln!("report: {}", a.out.join("report.html").display());
+            Ok(())
+        }
+        Command::Scale(a) => {
+            let methods = if a.methods.is_empty() {
+                vec![(VisibilityMethod::Scanline, ShadowMethod::None), (VisibilityMethod::ZBuffer, ShadowMethod::None)]
+            } else {
+                a.methods
+            };
+            let opts = ScaleOptions {
+                sweep: a.sweep,
+                values: a.values,
+                methods,
+                shadow_options: a.shadow.options(false)?,
+                runs: a.runs,
+                width: a.width,
+                height: a.height,
+                count: a.count,
+                size: a.size,
+                counter: a.counter,
+                out: a.out.clone(),
+            };
+            for p in scale(&opts)? {
+                eprintln!(
+                    "{:>10} {:>9} + {:<26} {:>9.1} ms  {}",
+                    p.value, p.visibility, p.shadows, p.time_ms, p.counter
+                );
+            }
+            eprintln!("written: {}", a.out.display());
+            Ok(())
+        }
+        Command::Trace(a) => {
+            let scene = Scene::load(&a.scene)?;
+            let t = umbra::study::trace::trace(&scene, a.line, a.shadows, &a.shadow.options(false)?)?;
+            if a.json {
+                println!("{}", serde_json::to_string_pretty(&t).map_err(|e| Error::Invalid(e.to_string()))?);
+            } else {
+                print!("{}", t.text(&scene, a.x));
             }
             Ok(())
         }

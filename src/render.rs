@@ -6,7 +6,7 @@
 //! renderer does.
 
 use crate::error::Result;
-use crate::frame::Frame;
+use crate::frame::{Frame, PixelCounters};
 use crate::scene::Scene;
 use crate::shading::{RunShading, Shader};
 use crate::shadow::{ShadowContext, ShadowMethod, ShadowOptions};
@@ -32,6 +32,8 @@ pub struct RenderOptions {
     /// Show a progress bar on stderr when the render takes more than a second and stderr is
     /// a terminal.
     pub progress: bool,
+    /// Collect per-pixel counters into [`Frame::counters`].
+    pub pixel_counters: bool,
 }
 
 impl Default for RenderOptions {
@@ -41,6 +43,7 @@ impl Default for RenderOptions {
             shadows: ShadowMethod::DEFAULT,
             shadow_options: ShadowOptions::default(),
             progress: false,
+            pixel_counters: false,
         }
     }
 }
@@ -74,6 +77,21 @@ struct Band<'f> {
     color: &'f mut [Vec3],
     id: &'f mut [u32],
     light: Vec<&'f mut [f32]>,
+    tests: Option<&'f mut [u32]>,
+}
+
+/// How many screen polygons cover each pixel centre.
+fn depth_complexity(screen: &[crate::view::ScreenPolygon], w: u32, h: u32) -> Vec<u32> {
+    let mut count = vec![0u32; (w * h) as usize];
+    let mut table = crate::scan::EdgeTable::new(h);
+    for p in screen {
+        crate::scan::for_each_span(&mut table, &[&p.ring], w, h, 0..h, |y, x0, x1| {
+            for c in &mut count[(y * w + x0) as usize..(y * w + x1) as usize] {
+                *c += 1;
+            }
+        });
+    }
+    count
 }
 
 /// Renders `scene` with the chosen stages.
@@ -98,6 +116,15 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     let t = Instant::now();
     let visibility = opts.visibility.prepare(scene, &view, &screen, &mut stats.visibility_counters);
     let runs = crate::visibility::resolve(&*visibility, h, &mut stats.visibility_counters);
+    let mut pixel_counters = opts.pixel_counters.then(|| {
+        let mut splits = vec![0u16; (w * h) as usize];
+        visibility.span_splits(0..h, &mut splits);
+        PixelCounters {
+            depth_complexity: depth_complexity(&screen, w, h),
+            span_splits: splits.into_iter().map(u32::from).collect(),
+            shadow_tests: vec![0; (w * h) as usize],
+        }
+    });
     drop(visibility);
     stats.time_ms.insert("visibility", ms(t.elapsed()));
 
@@ -114,6 +141,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     let chunk = (band * w) as usize;
     // Each band gets its own rows of every buffer.
     let mut light_rows: Vec<_> = frame.light.iter_mut().map(|l| l.chunks_mut(chunk)).collect();
+    let mut test_rows = pixel_counters.as_mut().map(|c| c.shadow_tests.chunks_mut(chunk));
     let jobs: Vec<Band> = frame
         .color
         .chunks_mut(chunk)
@@ -124,13 +152,14 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
             color,
             id,
             light: light_rows.iter_mut().flat_map(|rows| rows.next()).collect(),
+            tests: test_rows.as_mut().and_then(|rows| rows.next()),
         })
         .collect();
     let progress = Mutex::new(Progress::new(opts.progress, h as u64));
     let counters: Vec<Counters> = jobs
         .into_par_iter()
         .map(|out| {
-            let Band { y0, color, id, mut light } = out;
+            let Band { y0, color, id, mut light, mut tests } = out;
             let y1 = y0 + (id.len() / w as usize) as u32;
             let mut shadow = Counters::default();
             let mut walker = shadows.walker();
@@ -152,6 +181,13 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
                             let lit = &mut lit[..(run.x1 - run.x0) as usize];
                             if sample.on_seen_side(&poly.plane, view.eye) {
                                 walker.lit(l, s, y, run, lit);
+                                if let Some(tests) = tests.as_deref_mut() {
+                                    for (x0, x1, n) in walker.decision().tested {
+                                        for t in &mut tests[row + x0 as usize..row + x1 as usize] {
+                                            *t += n;
+                                        }
+                                    }
+                                }
                             } else {
                                 lit.fill(0.0);
                                 self_shadowed += 1;
@@ -180,6 +216,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     }
     stats.time_ms.insert("shading", ms(t.elapsed()));
     stats.time_ms.insert("total", ms(start.elapsed()));
+    frame.counters = pixel_counters;
     let outlines = shadows.outlines();
     Ok(Rendered { frame, stats, outlines })
 }

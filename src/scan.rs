@@ -155,6 +155,11 @@ impl EdgeTable {
         self.lines.clone()
     }
 
+    /// Every edge as (tag, first line, end line, x at its top, y at its top, dx/dy).
+    pub fn edges(&self) -> impl Iterator<Item = (u32, u32, u32, f64, f64, f64)> + '_ {
+        self.edges.iter().map(|e| (e.tag, e.first, e.end, e.x_top, e.y_top, e.dxdy))
+    }
+
     /// Bytes held by the table.
     pub fn bytes(&self) -> usize {
         self.edges.capacity() * std::mem::size_of::<Edge>() + self.bucket.capacity() * 4

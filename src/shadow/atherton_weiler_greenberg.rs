@@ -25,7 +25,7 @@
 
 use super::overlay::{Interval, Overlay, OverlayWalker};
 use super::projection::edge_on;
-use super::{ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::weiler_atherton::{clip, ClipError, Region};
 use crate::geometry::{clip_polygon, Plane};
@@ -526,6 +526,15 @@ impl ShadowWalker for Walker<'_> {
         self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut self.intervals);
         for iv in &self.intervals {
             lit[(iv.start - run.x0) as usize..(iv.end - run.x0) as usize].fill(1.0);
+        }
+    }
+
+    fn decision(&self) -> Decision {
+        let on: Vec<String> =
+            self.intervals.iter().map(|i| format!("#{} covers {}..{}", i.tag, i.start, i.end)).collect();
+        Decision {
+            tested: self.intervals.iter().map(|i| (i.start, i.end, 1)).collect(),
+            note: format!("{} lit detail polygon(s) on this polygon cover [{}]", self.intervals.len(), on.join(", ")),
         }
     }
 }

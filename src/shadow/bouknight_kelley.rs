@@ -34,7 +34,7 @@
 
 use super::overlay::{Interval, Overlay, OverlayWalker};
 use super::projection::{bounding_rectangle, edge_on, light_side, Projector};
-use super::{ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -307,6 +307,7 @@ impl ShadowStage for BouknightKelley<'_> {
             segments: 0,
             splits: 0,
             depth_max: 0,
+            last: (0, 0),
         })
     }
 }
@@ -318,6 +319,8 @@ struct Walker<'s> {
     segments: u64,
     splits: u64,
     depth_max: u32,
+    /// Segments and splits of the last run.
+    last: (u64, u64),
 }
 
 impl Walker<'_> {
@@ -361,8 +364,25 @@ impl ShadowWalker for Walker<'_> {
         let k = self.stage.ctx.sample_index(light, sample);
         let mut intervals = std::mem::take(&mut self.intervals);
         self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut intervals);
+        let before = (self.segments, self.splits);
         self.segment(run.x0, run.x1, &intervals, 0, run.x0, lit);
+        self.last = (self.segments - before.0, self.splits - before.1);
         self.intervals = intervals;
+    }
+
+    fn decision(&self) -> Decision {
+        let on: Vec<String> =
+            self.intervals.iter().map(|i| format!("#{} covers {}..{}", i.tag, i.start, i.end)).collect();
+        Decision {
+            tested: self.intervals.iter().map(|i| (i.start, i.end, 1)).collect(),
+            note: format!(
+                "{} shadow polygon(s) on this polygon touch the run [{}]; {} segment(s) examined, {} split(s)",
+                self.intervals.len(),
+                on.join(", "),
+                self.last.0,
+                self.last.1
+            ),
+        }
     }
 
     fn finish(&mut self, counters: &mut Counters) {

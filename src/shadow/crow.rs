@@ -26,7 +26,7 @@
 //! volume never counts for its own face.
 
 use super::volumes::{Adjacency, Counting, ScreenVolumes, NONE};
-use super::{ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::scan::{boundary, ActiveEdges, EdgeTable};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -84,6 +84,8 @@ impl ShadowStage for Crow<'_> {
                 })
                 .collect(),
             events: Vec::new(),
+            last_pieces: Vec::new(),
+            last_counts: Vec::new(),
             yc: 0.0,
             runs: 0,
             events_total: 0,
@@ -131,6 +133,9 @@ struct Walker<'s> {
     stage: &'s Crow<'s>,
     lines: Vec<LineState<'s>>,
     events: Vec<(u32, i32)>,
+    /// The last run's coverage pieces (polygon, start, end) and its counted pieces.
+    last_pieces: Vec<(u32, u32, u32)>,
+    last_counts: Vec<(u32, u32, i32)>,
     yc: f64,
     runs: u64,
     events_total: u64,
@@ -186,6 +191,8 @@ impl ShadowWalker for Walker<'_> {
         }
         // Events: where each covering polygon starts and stops counting.
         self.events.clear();
+        self.last_pieces.clone_from(&pieces);
+        self.last_counts.clear();
         for (t, s, e) in pieces {
             if s >= e {
                 continue;
@@ -233,11 +240,25 @@ impl ShadowWalker for Walker<'_> {
             }
             let next = self.events.get(i).map_or(run.x1, |e| e.0.min(run.x1));
             lit[(x - run.x0) as usize..(next - run.x0) as usize].fill(if count > 0 { 0.0 } else { 1.0 });
+            self.last_counts.push((x, next, count));
             pieces_made += 1;
             x = next;
         }
         if pieces_made > 1 {
             self.split += 1;
+        }
+    }
+
+    fn decision(&self) -> Decision {
+        let counts: Vec<String> = self.last_counts.iter().map(|(a, b, c)| format!("{a}..{b}: {c}")).collect();
+        Decision {
+            tested: self.last_pieces.iter().map(|&(_, s, e)| (s, e, 1)).collect(),
+            note: format!(
+                "{} shadow polygon piece(s) cover the run, {} event(s); counts [{}]",
+                self.last_pieces.len(),
+                self.events.len(),
+                counts.join(", ")
+            ),
         }
     }
 

@@ -125,6 +125,21 @@ pub trait ShadowWalker {
 
     /// Adds the walker's counters.
     fn finish(&mut self, _counters: &mut Counters) {}
+
+    /// What the last [`ShadowWalker::lit`] call did, for traces and per-pixel counter images.
+    fn decision(&self) -> Decision {
+        Decision::default()
+    }
+}
+
+/// What a shadow walker did for one run: how much it tested at each pixel, and a note.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct Decision {
+    /// Pixel ranges `start..end` and how many of the stage's polygons (shadow polygons,
+    /// detail polygons, volume polygons), texels or rays were tested at each of their pixels.
+    pub tested: Vec<(u32, u32, u32)>,
+    /// The stage's own account, in a line.
+    pub note: String,
 }
 
 /// The shadow methods, chosen by name.

@@ -21,7 +21,7 @@
 //! side; those parts of a caster are clipped away first (w > 0 in the projection).
 
 use super::overlay::{Interval, Overlay, OverlayWalker};
-use super::{ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::{clip_polygon, Plane};
 use crate::scene::LightSample;
@@ -153,6 +153,15 @@ impl ShadowWalker for Walker<'_> {
         self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut self.intervals);
         for iv in &self.intervals {
             lit[(iv.start - run.x0) as usize..(iv.end - run.x0) as usize].fill(0.0);
+        }
+    }
+
+    fn decision(&self) -> Decision {
+        let on: Vec<String> =
+            self.intervals.iter().map(|i| format!("#{} covers {}..{}", i.tag, i.start, i.end)).collect();
+        Decision {
+            tested: self.intervals.iter().map(|i| (i.start, i.end, 1)).collect(),
+            note: format!("{} flattened caster(s) on this polygon cover [{}]", self.intervals.len(), on.join(", ")),
         }
     }
 }

@@ -2,7 +2,7 @@
 //! point toward the sample, tested against a BVH of the shadow-casting polygons (section 3 of
 //! the contract, directly). Simple and obviously right; the oracle for the exact stages.
 
-use super::{ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::bvh::Bvh;
 use crate::scene::LightSample;
 use crate::stats::Counters;
@@ -27,11 +27,12 @@ impl<'a> RayCastShadows<'a> {
 struct Walker<'s> {
     stage: &'s RayCastShadows<'s>,
     rays: u64,
+    last: (u32, u32),
 }
 
 impl ShadowStage for RayCastShadows<'_> {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
-        Box::new(Walker { stage: self, rays: 0 })
+        Box::new(Walker { stage: self, rays: 0, last: (0, 0) })
     }
 }
 
@@ -53,6 +54,14 @@ impl ShadowWalker for Walker<'_> {
             *out = if blocked { 0.0 } else { 1.0 };
         }
         self.rays += lit.len() as u64;
+        self.last = (run.x0, run.x1);
+    }
+
+    fn decision(&self) -> Decision {
+        Decision {
+            tested: vec![(self.last.0, self.last.1, 1)],
+            note: format!("{} shadow ray(s)", self.last.1 - self.last.0),
+        }
     }
 
     fn finish(&mut self, counters: &mut Counters) {

@@ -6,7 +6,7 @@
 //! shadow where its count is above zero.
 
 use super::volumes::{Adjacency, ScreenVolumes};
-use super::{ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::scan::{for_each_span, EdgeTable};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -96,5 +96,9 @@ impl ShadowWalker for Walker<'_> {
         for (o, &m) in lit.iter_mut().zip(mask) {
             *o = if m { 1.0 } else { 0.0 };
         }
+    }
+
+    fn decision(&self) -> Decision {
+        Decision { tested: Vec::new(), note: "read from the stencil count rasterised in preparation".into() }
     }
 }

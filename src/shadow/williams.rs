@@ -18,7 +18,7 @@
 //! every pixel written to a screen-sized buffer, blurred by the seed's separable 15-tap
 //! Gaussian, and used when shading).
 
-use super::{ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::scene::{Camera, LightSample};
 use crate::stats::Counters;
 use crate::view::{DepthPlane, ScreenPolygon, View};
@@ -448,13 +448,15 @@ pub fn seed_gaussian_taps() -> Vec<(i64, f32)> {
 
 impl ShadowStage for Williams<'_> {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
-        Box::new(Walker { stage: self, lookups: 0 })
+        Box::new(Walker { stage: self, lookups: 0, last: (0, 0, 0) })
     }
 }
 
 struct Walker<'s> {
     stage: &'s Williams<'s>,
     lookups: u64,
+    /// The last run and the texels compared per pixel.
+    last: (u32, u32, u32),
 }
 
 impl ShadowWalker for Walker<'_> {
@@ -473,6 +475,12 @@ impl ShadowWalker for Walker<'_> {
         };
         st.lookup_run(k, st.ctx.samples[light][sample], line, run, size, lit);
         self.lookups += lit.len() as u64;
+        self.last = (run.x0, run.x1, size * size);
+    }
+
+    fn decision(&self) -> Decision {
+        let (a, b, texels) = self.last;
+        Decision { tested: vec![(a, b, texels)], note: format!("{} map lookup(s) of {texels} texel(s) each", b - a) }
     }
 
     fn finish(&mut self, counters: &mut Counters) {

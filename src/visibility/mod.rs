@@ -7,7 +7,7 @@ mod scanline;
 mod zbuffer;
 
 pub use ray_cast::RayCastVisibility;
-pub use scanline::ScanlineVisibility;
+pub use scanline::{ScanlineVisibility, SpanRecord};
 pub use zbuffer::{rasterize, Depth, DepthBuffer, ZBufferVisibility};
 
 use crate::error::{Error, Result};
@@ -17,7 +17,7 @@ use crate::view::{ScreenPolygon, View};
 use std::ops::Range;
 
 /// A run of pixels `x0..x1` on one scanline that all see scene polygon `poly`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub struct Run {
     /// First pixel.
     pub x0: u32,
@@ -32,6 +32,10 @@ pub trait Visibility: Sync {
     /// Walks `lines` in increasing order, calling `f(line, runs)` with each line's runs in
     /// increasing x (lines with no runs included). Several bands may be walked at once.
     fn walk(&self, lines: Range<u32>, counters: &mut Counters, f: &mut dyn FnMut(u32, &[Run]));
+
+    /// Adds to `out` (one entry per pixel of `lines`, row-major) how many times each pixel's
+    /// span was split; only the scanline stage splits spans.
+    fn span_splits(&self, _lines: Range<u32>, _out: &mut [u16]) {}
 }
 
 /// The visibility methods, chosen by name.
@@ -68,7 +72,7 @@ impl VisibilityMethod {
         counters: &mut Counters,
     ) -> Box<dyn Visibility + 'a> {
         match self {
-            VisibilityMethod::Scanline => Box::new(ScanlineVisibility::new(screen, view, counters)),
+            VisibilityMethod::Scanline => Box::new(ScanlineVisibility::new(scene, screen, view, counters)),
             VisibilityMethod::ZBuffer => Box::new(ZBufferVisibility::new(screen, view, counters)),
             VisibilityMethod::RayCast => Box::new(RayCastVisibility::new(scene, view)),
         }

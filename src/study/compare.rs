@@ -1,0 +1,355 @@
+//! `umbra compare`: renders one scene with every visibility × shadow combination asked for,
+//! times each (median of several runs, through the same [`crate::render()`] the benchmarks
+//! call), measures each against the exact ray-cast reference (share of interior pixels wrong,
+//! and a diff image), and writes `report.html`, `results.json` and `results.csv`.
+//!
+//! Every method in [`VisibilityMethod::ALL`] and [`ShadowMethod::ALL`] takes part by
+//! default: a new stage appears here without more code. A method that cannot handle the
+//! scene (planar shadows with no receiver, say) is reported as not applicable.
+
+use crate::error::{Error, Result};
+use crate::frame::Frame;
+use crate::render::{render, RenderOptions};
+use crate::scene::Scene;
+use crate::shadow::{ShadowMethod, ShadowOptions};
+use crate::visibility::VisibilityMethod;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// What to compare.
+#[derive(Debug, Clone)]
+pub struct CompareOptions {
+    /// Visibility stages.
+    pub visibility: Vec<VisibilityMethod>,
+    /// Shadow stages.
+    pub shadows: Vec<ShadowMethod>,
+    /// Options every shadow stage gets.
+    pub shadow_options: ShadowOptions,
+    /// Timed runs per method (the median is reported).
+    pub runs: usize,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+}
+
+impl Default for CompareOptions {
+    fn default() -> Self {
+        CompareOptions {
+            visibility: VisibilityMethod::ALL.to_vec(),
+            shadows: ShadowMethod::ALL.to_vec(),
+            shadow_options: ShadowOptions::default(),
+            runs: 3,
+            out: PathBuf::from("compare"),
+            progress: false,
+        }
+    }
+}
+
+/// One method's line in the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct MethodResult {
+    /// Visibility stage.
+    pub visibility: String,
+    /// Shadow stage.
+    pub shadows: String,
+    /// `ok`, or why the method does not apply.
+    pub status: String,
+    /// Whether the shadow stage is meant to be exact.
+    pub exact: bool,
+    /// Median total time of the runs, milliseconds.
+    pub time_ms: f64,
+    /// Every run's total time.
+    pub times_ms: Vec<f64>,
+    /// The median run's time per step.
+    pub step_ms: BTreeMap<String, f64>,
+    /// Interior pixels of the reference (3×3 uniform in id and light values).
+    pub interior_pixels: usize,
+    /// Interior pixels where this method's id or a lit value differs from the reference.
+    pub wrong_pixels: usize,
+    /// `wrong_pixels / interior_pixels`.
+    pub error_share: f64,
+    /// The image, relative to the report.
+    pub image: String,
+    /// The diff image, relative to the report.
+    pub diff: String,
+    /// Visibility and shadow counters of the median run.
+    pub counters: BTreeMap<String, u64>,
+}
+
+/// The whole comparison.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// The scene's name.
+    pub scene: String,
+    /// Image size.
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// Polygons.
+    pub polygons: usize,
+    /// The reference image, relative to the report.
+    pub reference: String,
+    /// One entry per method.
+    pub results: Vec<MethodResult>,
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    s.get(s.len() / 2).copied().unwrap_or(0.0)
+}
+
+/// Compares `got` with the reference at the reference's interior pixels: (interior, wrong,
+/// diff image). The diff shows the reference in grey, wrong interior pixels in red and
+/// differing edge pixels (not counted) in yellow.
+pub fn diff(reference: &Frame, got: &Frame) -> (usize, usize, image::RgbImage) {
+    let grey = reference.color_image(None);
+    let mut img = image::RgbImage::new(reference.width, reference.height);
+    let (mut interior, mut wrong) = (0, 0);
+    for y in 0..reference.height {
+        for x in 0..reference.width {
+            let k = (y * reference.width + x) as usize;
+            let differs =
+                reference.id[k] != got.id[k] || reference.light.iter().zip(&got.light).any(|(a, b)| a[k] != b[k]);
+            let g = grey.get_pixel(x, y).0.iter().map(|&c| c as u32).sum::<u32>() / 6;
+            let px = if reference.is_interior(x, y) {
+                interior += 1;
+                wrong += differs as usize;
+                if differs {
+                    [230, 30, 30]
+                } else {
+                    [g as u8; 3]
+                }
+            } else if differs {
+                [220, 200, 40]
+            } else {
+                [g as u8; 3]
+            };
+            img.put_pixel(x, y, image::Rgb(px));
+        }
+    }
+    (interior, wrong, img)
+}
+
+/// Runs the comparison and writes the report into `opts.out`.
+pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Report> {
+    let img_dir = opts.out.join("img");
+    std::fs::create_dir_all(&img_dir).map_err(|e| Error::Io { path: img_dir.clone(), source: e })?;
+    let save = |img: image::RgbImage, file: &str| -> Result<String> {
+        let path = img_dir.join(file);
+        img.save_with_format(&path, image::ImageFormat::Png).map_err(|e| Error::Image { path, source: e })?;
+        Ok(format!("img/{file}"))
+    };
+    let reference_opts = RenderOptions {
+        visibility: VisibilityMethod::RayCast,
+        shadows: ShadowMethod::RayCast,
+        shadow_options: opts.shadow_options.clone(),
+        ..RenderOptions::default()
+    };
+    let reference = render(scene, &reference_opts)?.frame;
+    let reference_image = save(reference.color_image(None), "reference.png")?;
+    let total = (opts.visibility.len() * opts.shadows.len() * opts.runs.max(1)) as u64;
+    let bar = if opts.progress { indicatif::ProgressBar::new(total) } else { indicatif::ProgressBar::hidden() };
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{msg:32} {bar:40} {pos}/{len} renders {elapsed}") {
+        bar.set_style(style);
+    }
+    let mut results = Vec::new();
+    for &v in &opts.visibility {
+        for &s in &opts.shadows {
+            bar.set_message(format!("{v} + {s}"));
+            let id = format!("{v}-{s}");
+            let ropts = RenderOptions {
+                visibility: v,
+                shadows: s,
+                shadow_options: opts.shadow_options.clone(),
+                ..RenderOptions::default()
+            };
+            let mut runs = Vec::new();
+            let mut status = "ok".to_string();
+            for _ in 0..opts.runs.max(1) {
+                match render(scene, &ropts) {
+                    Ok(r) => runs.push(r),
+                    Err(Error::Invalid(why)) => {
+                        status = format!("not applicable: {why}");
+                        break;
+                    }
+                    Err(e) => return Err(e),
+                }
+                bar.inc(1);
+            }
+            let times: Vec<f64> = runs.iter().map(|r| r.stats.time_ms.get("total").copied().unwrap_or(0.0)).collect();
+            let med = median(&times);
+            let Some(run) = runs.iter().find(|r| r.stats.time_ms.get("total") == Some(&med)).or(runs.first()) else {
+                results.push(MethodResult {
+                    visibility: v.name().into(),
+                    shadows: s.name().into(),
+                    status,
+                    exact: s.is_exact(),
+                    time_ms: 0.0,
+                    times_ms: Vec::new(),
+                    step_ms: BTreeMap::new(),
+                    interior_pixels: 0,
+                    wrong_pixels: 0,
+                    error_share: 0.0,
+                    image: String::new(),
+                    diff: String::new(),
+                    counters: BTreeMap::new(),
+                });
+                continue;
+            };
+            let (interior, wrong, diff_img) = diff(&reference, &run.frame);
+            let counters = run
+                .stats
+                .visibility_counters
+                .iter()
+                .map(|(k, v)| (format!("visibility.{k}"), v))
+                .chain(run.stats.shadow_counters.iter().map(|(k, v)| (format!("shadow.{k}"), v)))
+                .collect();
+            results.push(MethodResult {
+                visibility: v.name().into(),
+                shadows: s.name().into(),
+                status,
+                exact: s.is_exact(),
+                time_ms: med,
+                times_ms: times.clone(),
+                step_ms: run.stats.time_ms.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+                interior_pixels: interior,
+                wrong_pixels: wrong,
+                error_share: wrong as f64 / interior.max(1) as f64,
+                image: save(run.frame.color_image(None), &format!("{id}.png"))?,
+                diff: save(diff_img, &format!("{id}-diff.png"))?,
+                counters,
+            });
+        }
+    }
+    bar.finish_and_clear();
+    let report = Report {
+        scene: name.into(),
+        width: scene.camera.width,
+        height: scene.camera.height,
+        polygons: scene.polygons.len(),
+        reference: reference_image,
+        results,
+    };
+    write_files(&report, &opts.out)?;
+    Ok(report)
+}
+
+fn write(path: &Path, text: &str) -> Result<()> {
+    std::fs::write(path, text).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+fn write_files(report: &Report, out: &Path) -> Result<()> {
+    let json = serde_json::to_string_pretty(report).map_err(|e| Error::Invalid(e.to_string()))?;
+    write(&out.join("results.json"), &json)?;
+    let mut csv = String::from("visibility,shadows,status,exact,time_ms,interior_pixels,wrong_pixels,error_share\n");
+    for r in &report.results {
+        let _ = writeln!(
+            csv,
+            "{},{},\"{}\",{},{:.3},{},{},{:.6}",
+            r.visibility,
+            r.shadows,
+            r.status.replace('"', "'"),
+            r.exact,
+            r.time_ms,
+            r.interior_pixels,
+            r.wrong_pixels,
+            r.error_share
+        );
+    }
+    write(&out.join("results.csv"), &csv)?;
+    write(&out.join("report.html"), &html(report))
+}
+
+fn html(report: &Report) -> String {
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>umbra compare: {scene}</title>\n<style>\n\
+         body {{ font-family: sans-serif; margin: 1.5em; }}\ntable {{ border-collapse: collapse; font-size: 0.9em; }}\n\
+         th, td {{ border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: right; }}\nth {{ cursor: pointer; background: #eee; }}\n\
+         td.name {{ text-align: left; }}\n.na {{ color: #888; }}\n.grid {{ display: flex; flex-wrap: wrap; gap: 1em; }}\n\
+         figure {{ margin: 0; }}\nfigure img {{ width: 320px; image-rendering: pixelated; }}\nfigcaption {{ font-size: 0.85em; }}\n</style>\n</head>\n<body>\n\
+         <h1>umbra compare: {scene}</h1>\n<p>{w}&times;{h} pixels, {n} polygons. Errors are counted at the reference's interior pixels \
+         (3&times;3 neighbourhood uniform in face id and lit values); the reference is ray-cast visibility with ray-cast shadows. \
+         In the diff images, red marks wrong interior pixels and yellow marks differing pixels on edges (not counted).</p>\n",
+        scene = escape(&report.scene),
+        w = report.width,
+        h = report.height,
+        n = report.polygons
+    );
+    h.push_str("<h2>Times and errors</h2>\n<p>Click a column to sort.</p>\n<table id=\"results\">\n<thead><tr>");
+    for col in [
+        "visibility",
+        "shadows",
+        "status",
+        "exact",
+        "time (ms)",
+        "visibility (ms)",
+        "shadow prepare (ms)",
+        "shading (ms)",
+        "wrong / interior",
+        "error",
+    ] {
+        let _ = write!(h, "<th>{col}</th>");
+    }
+    h.push_str("</tr></thead>\n<tbody>\n");
+    for r in &report.results {
+        let step = |k: &str| r.step_ms.get(k).map_or(String::new(), |v| format!("{v:.1}"));
+        let class = if r.status == "ok" { "" } else { " class=\"na\"" };
+        let _ = writeln!(
+            h,
+            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td></tr>",
+            r.visibility,
+            r.shadows,
+            escape(&r.status),
+            if r.exact { "yes" } else { "no" },
+            r.time_ms,
+            step("visibility"),
+            step("shadow_prepare"),
+            step("shading"),
+            r.wrong_pixels,
+            r.interior_pixels,
+            100.0 * r.error_share
+        );
+    }
+    h.push_str("</tbody>\n</table>\n<h2>Images</h2>\n<div class=\"grid\">\n");
+    let _ = writeln!(
+        h,
+        "<figure><img src=\"{}\" alt=\"reference\"><figcaption>reference (ray-cast)</figcaption></figure>",
+        report.reference
+    );
+    for r in report.results.iter().filter(|r| !r.image.is_empty()) {
+        let label = format!("{} + {}", r.visibility, r.shadows);
+        let _ = writeln!(
+            h,
+            "<figure><img src=\"{}\" alt=\"{label}\"><figcaption>{label}: {:.1} ms</figcaption></figure>\n<figure><img src=\"{}\" alt=\"{label} diff\"><figcaption>{label}: {} wrong</figcaption></figure>",
+            r.image, r.time_ms, r.diff, r.wrong_pixels
+        );
+    }
+    h.push_str("</div>\n<h2>Counters</h2>\n");
+    for r in report.results.iter().filter(|r| !r.counters.is_empty()) {
+        let _ = write!(h, "<h3>{} + {}</h3>\n<table>\n", r.visibility, r.shadows);
+        for (k, v) in &r.counters {
+            let _ = writeln!(h, "<tr><td class=\"name\">{}</td><td>{v}</td></tr>", escape(k));
+        }
+        h.push_str("</table>\n");
+    }
+    h.push_str(
+        "<script>\ndocument.querySelectorAll('#results th').forEach((th, i) => th.addEventListener('click', () => {\n\
+         const body = th.closest('table').tBodies[0];\n\
+         const rows = Array.from(body.rows);\n\
+         const key = r => { const t = r.cells[i].textContent; const n = parseFloat(t); return isNaN(n) ? t : n; };\n\
+         const dir = th.dataset.dir === 'up' ? -1 : 1; th.dataset.dir = dir === 1 ? 'up' : 'down';\n\
+         rows.sort((a, b) => (key(a) > key(b) ? 1 : key(a) < key(b) ? -1 : 0) * dir).forEach(r => body.appendChild(r));\n\
+         }));\n</script>\n</body>\n</html>\n",
+    );
+    h
+}

@@ -1,0 +1,225 @@
+//! `umbra scale`: how cost grows with a scene parameter, after Slater et al., "A statistical
+//! comparison of two hidden surface techniques: the scan-line and z-buffer algorithms"
+//! (Computer Graphics Forum 1992): a generated scene family is swept over polygon count,
+//! depth complexity, polygon size, distribution or resolution; every method asked for is
+//! timed (median of runs) with its counters; the results go to a CSV file and SVG plots.
+
+use crate::error::{Error, Result};
+use crate::generate;
+use crate::render::{render, RenderOptions};
+use crate::scene::Scene;
+use crate::shadow::{ShadowMethod, ShadowOptions};
+use crate::visibility::VisibilityMethod;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// What is swept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sweep {
+    /// Floor with an N×N grid of cubes (value: N).
+    Cubes,
+    /// Stacked quads (value: depth complexity).
+    Quads,
+    /// Spheres on a floor (value: triangles; `count` spheres).
+    Spheres,
+    /// Scattered triangles, uniform (value: count; `size` their size).
+    Scattered,
+    /// Scattered triangles clustered about the centre (value: count).
+    Clustered,
+    /// Scattered triangles (value: their size; `count` of them).
+    Size,
+    /// The cubes scene at a resolution (value: width; height is 9/16 of it).
+    Resolution,
+}
+
+impl Sweep {
+    /// Names on the command line.
+    pub const NAMES: [(&'static str, Sweep); 7] = [
+        ("cubes", Sweep::Cubes),
+        ("quads", Sweep::Quads),
+        ("spheres", Sweep::Spheres),
+        ("scattered", Sweep::Scattered),
+        ("clustered", Sweep::Clustered),
+        ("size", Sweep::Size),
+        ("resolution", Sweep::Resolution),
+    ];
+
+    /// The sweep's name.
+    pub fn name(self) -> &'static str {
+        Self::NAMES.iter().find(|n| n.1 == self).map_or("?", |n| n.0)
+    }
+
+    /// What the value means.
+    pub fn parameter(self) -> &'static str {
+        match self {
+            Sweep::Cubes => "cubes per side",
+            Sweep::Quads => "depth complexity",
+            Sweep::Spheres => "triangles",
+            Sweep::Scattered | Sweep::Clustered => "triangles",
+            Sweep::Size => "triangle size",
+            Sweep::Resolution => "image width",
+        }
+    }
+
+    /// The scene for `value`.
+    pub fn scene(self, value: f64, o: &ScaleOptions) -> Result<Scene> {
+        let (w, h) = (o.width, o.height);
+        match self {
+            Sweep::Cubes => generate::cubes(value as u32, true, w, h),
+            Sweep::Quads => generate::stacked_quads(value as u32, w, h),
+            Sweep::Spheres => generate::spheres(value as u32, o.count, w, h),
+            Sweep::Scattered => generate::scattered(value as u32, o.size, false, w, h),
+            Sweep::Clustered => generate::scattered(value as u32, o.size, true, w, h),
+            Sweep::Size => generate::scattered(o.count, value, false, w, h),
+            Sweep::Resolution => generate::cubes(10, true, value as u32, (value * 9.0 / 16.0).max(1.0) as u32),
+        }
+    }
+}
+
+impl std::str::FromStr for Sweep {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Self::NAMES.iter().find(|n| n.0 == s).map(|n| n.1).ok_or_else(|| {
+            let known: Vec<_> = Self::NAMES.iter().map(|n| n.0).collect();
+            Error::Invalid(format!("unknown sweep '{s}' (known: {})", known.join(", ")))
+        })
+    }
+}
+
+/// A sweep's settings.
+#[derive(Debug, Clone)]
+pub struct ScaleOptions {
+    /// What to sweep.
+    pub sweep: Sweep,
+    /// The values.
+    pub values: Vec<f64>,
+    /// The methods: (visibility, shadows).
+    pub methods: Vec<(VisibilityMethod, ShadowMethod)>,
+    /// Options every shadow stage gets.
+    pub shadow_options: ShadowOptions,
+    /// Timed runs per point (median reported).
+    pub runs: usize,
+    /// Image size (except for the resolution sweep).
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// Spheres for the sphere sweep; triangles for the size sweep.
+    pub count: u32,
+    /// Triangle size for the scattered sweeps.
+    pub size: f64,
+    /// A counter to plot besides time (for example `visibility.spans`).
+    pub counter: String,
+    /// Output folder.
+    pub out: PathBuf,
+}
+
+/// One point of a sweep.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Point {
+    /// The swept value.
+    pub value: f64,
+    /// Method.
+    pub visibility: String,
+    /// Method.
+    pub shadows: String,
+    /// Polygons in the scene.
+    pub polygons: usize,
+    /// Median total time, ms.
+    pub time_ms: f64,
+    /// The chosen counter.
+    pub counter: u64,
+}
+
+/// Runs the sweep, writes `scale.csv`, `time.svg` and `counter.svg` into `out`.
+pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
+    std::fs::create_dir_all(&o.out).map_err(|e| Error::Io { path: o.out.clone(), source: e })?;
+    let mut points = Vec::new();
+    for &value in &o.values {
+        let scene = o.sweep.scene(value, o)?;
+        for &(v, s) in &o.methods {
+            let opts = RenderOptions {
+                visibility: v,
+                shadows: s,
+                shadow_options: o.shadow_options.clone(),
+                ..RenderOptions::default()
+            };
+            let mut times = Vec::new();
+            let mut last = None;
+            for _ in 0..o.runs.max(1) {
+                let r = render(&scene, &opts)?;
+                times.push(r.stats.time_ms.get("total").copied().unwrap_or(0.0));
+                last = Some(r);
+            }
+            times.sort_by(f64::total_cmp);
+            let counter = last.map_or(0, |r| {
+                let (kind, name) = o.counter.split_once('.').unwrap_or(("visibility", &o.counter));
+                match kind {
+                    "shadow" => r.stats.shadow_counters.get(name),
+                    _ => r.stats.visibility_counters.get(name),
+                }
+            });
+            points.push(Point {
+                value,
+                visibility: v.name().into(),
+                shadows: s.name().into(),
+                polygons: scene.polygons.len(),
+                time_ms: times[times.len() / 2],
+                counter,
+            });
+        }
+    }
+    let mut csv = format!("{},visibility,shadows,polygons,time_ms,{}\n", o.sweep.name(), o.counter);
+    for p in &points {
+        let _ =
+            writeln!(csv, "{},{},{},{},{:.3},{}", p.value, p.visibility, p.shadows, p.polygons, p.time_ms, p.counter);
+    }
+    let path = o.out.join("scale.csv");
+    std::fs::write(&path, csv).map_err(|e| Error::Io { path, source: e })?;
+    plot(&o.out.join("time.svg"), o, &points, "time (ms)", |p| p.time_ms)?;
+    plot(&o.out.join("counter.svg"), o, &points, &o.counter, |p| p.counter as f64)?;
+    Ok(points)
+}
+
+/// A log-log plot of `y` against the swept value, one line per method.
+fn plot(path: &Path, o: &ScaleOptions, points: &[Point], label: &str, y: impl Fn(&Point) -> f64) -> Result<()> {
+    let err = |e: String| Error::Invalid(format!("{}: cannot draw the plot: {e}", path.display()));
+    let xs = points.iter().map(|p| p.value);
+    let (x0, x1) = (xs.clone().fold(f64::INFINITY, f64::min).max(1e-9), xs.fold(0.0, f64::max).max(1e-9));
+    let ys = points.iter().map(&y).filter(|v| *v > 0.0);
+    let (y0, y1) = (ys.clone().fold(f64::INFINITY, f64::min).clamp(1e-6, 1.0), ys.fold(1.0, f64::max));
+    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{label} against {}", o.sweep.parameter()), ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(36)
+        .y_label_area_size(60)
+        .build_cartesian_2d((x0 * 0.9..x1 * 1.1).log_scale(), (y0 * 0.8..y1 * 1.25).log_scale())
+        .map_err(|e| err(e.to_string()))?;
+    chart.configure_mesh().x_desc(o.sweep.parameter()).y_desc(label).draw().map_err(|e| err(e.to_string()))?;
+    for (i, &(v, s)) in o.methods.iter().enumerate() {
+        let colour = Palette99::pick(i).to_rgba();
+        let series: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| p.visibility == v.name() && p.shadows == s.name() && y(p) > 0.0)
+            .map(|p| (p.value, y(p)))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))
+            .map_err(|e| err(e.to_string()))?
+            .label(format!("{v} + {s}"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+        chart
+            .draw_series(series.into_iter().map(|p| Circle::new(p, 3, colour.filled())))
+            .map_err(|e| err(e.to_string()))?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(e.to_string()))?;
+    root.present().map_err(|e| err(e.to_string()))
+}

@@ -1,0 +1,211 @@
+//! `umbra trace`: what Watkins' algorithm and the shadow stage did on one scanline — the
+//! edges entering and leaving, the active edge table in order, each span with the polygons
+//! covering it, their depths at its ends and where it was split, the runs, and for every run
+//! and light sample the shadow stage's decision.
+
+use crate::error::{Error, Result};
+use crate::scan::ActiveEdges;
+use crate::scene::Scene;
+use crate::shadow::{Decision, ShadowContext, ShadowMethod, ShadowOptions};
+use crate::stats::Counters;
+use crate::view::View;
+use crate::visibility::{resolve, Run, ScanlineVisibility, SpanRecord, Visibility};
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// An edge of the edge table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EdgeTrace {
+    /// Scene polygon.
+    pub polygon: u32,
+    /// Its face id.
+    pub face: u32,
+    /// First line it is active on.
+    pub first_line: u32,
+    /// First line it is no longer active on.
+    pub end_line: u32,
+    /// Its top vertex.
+    pub top: (f64, f64),
+    /// dx/dy.
+    pub dxdy: f64,
+}
+
+/// One run's shadow decision for one light sample.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ShadowTrace {
+    /// Light.
+    pub light: usize,
+    /// Sample.
+    pub sample: usize,
+    /// The run.
+    pub x0: u32,
+    /// The run.
+    pub x1: u32,
+    /// The run's polygon.
+    pub polygon: u32,
+    /// The lit value over the run, as pieces `(start, end, value)`.
+    pub lit: Vec<(u32, u32, f32)>,
+    /// `false` when the same-side rule settled it (light behind the seen side).
+    pub asked_stage: bool,
+    /// The stage's decision.
+    pub decision: Decision,
+}
+
+/// Everything done on one line.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LineTrace {
+    /// The line.
+    pub line: u32,
+    /// Shadow stage traced.
+    pub shadows: String,
+    /// Edges whose first line this is.
+    pub entering: Vec<EdgeTrace>,
+    /// Edges active on the line before and not on this one.
+    pub leaving: Vec<EdgeTrace>,
+    /// The active edge table in order: (x of the crossing, scene polygon).
+    pub active: Vec<(f64, u32)>,
+    /// The spans as resolved.
+    pub spans: Vec<SpanRecord>,
+    /// The runs handed on.
+    pub runs: Vec<Run>,
+    /// The shadow stage's decisions.
+    pub decisions: Vec<ShadowTrace>,
+}
+
+/// Traces line `line` of `scene` with scanline visibility and the shadow stage `shadows`.
+pub fn trace(scene: &Scene, line: u32, shadows: ShadowMethod, options: &ShadowOptions) -> Result<LineTrace> {
+    let view = View::new(&scene.camera);
+    if line >= view.height {
+        return Err(Error::Invalid(format!("line {line} is outside the image (height {})", view.height)));
+    }
+    let screen = view.screen_polygons(scene);
+    let mut counters = Counters::default();
+    let vis = ScanlineVisibility::new(scene, &screen, &view, &mut counters);
+    let edge = |e: (u32, u32, u32, f64, f64, f64)| {
+        let poly = screen[e.0 as usize].poly;
+        EdgeTrace {
+            polygon: poly,
+            face: scene.polygons[poly as usize].face,
+            first_line: e.1,
+            end_line: e.2,
+            top: (e.3, e.4),
+            dxdy: e.5,
+        }
+    };
+    let entering = vis.table().edges().filter(|e| e.1 == line).map(edge).collect();
+    let leaving = vis.table().edges().filter(|e| e.2 == line).map(edge).collect();
+    let mut aet = ActiveEdges::new(vis.table(), line..line + 1);
+    let active = aet.advance_to(line).iter().map(|c| (c.x, screen[c.tag as usize].poly)).collect();
+    let (mut spans, mut runs) = (Vec::new(), Vec::new());
+    vis.walk_recorded(line..line + 1, &mut |_, r, s| {
+        runs = r.to_vec();
+        spans = s.to_vec();
+    });
+
+    let frame_runs = resolve(&vis as &dyn Visibility, view.height, &mut counters);
+    let ctx = ShadowContext::new(scene, &view, &frame_runs, options.clone());
+    let stage = shadows.prepare(&ctx, &mut counters)?;
+    let mut walker = stage.walker();
+    for y in 0..=line {
+        walker.start_line(y);
+    }
+    let mut decisions = Vec::new();
+    let mut lit = vec![0.0f32; view.width as usize];
+    for run in &runs {
+        let plane = &scene.polygons[run.poly as usize].plane;
+        for (l, s, sample) in ctx.all_samples() {
+            let lit = &mut lit[..(run.x1 - run.x0) as usize];
+            let asked = sample.on_seen_side(plane, view.eye);
+            let decision = if asked {
+                walker.lit(l, s, line, run, lit);
+                walker.decision()
+            } else {
+                lit.fill(0.0);
+                Decision { tested: Vec::new(), note: "the light is behind the seen side: in shadow".into() }
+            };
+            let mut pieces: Vec<(u32, u32, f32)> = Vec::new();
+            for (i, &v) in lit.iter().enumerate() {
+                let x = run.x0 + i as u32;
+                match pieces.last_mut() {
+                    Some(p) if p.2 == v && p.1 == x => p.1 = x + 1,
+                    _ => pieces.push((x, x + 1, v)),
+                }
+            }
+            decisions.push(ShadowTrace {
+                light: l,
+                sample: s,
+                x0: run.x0,
+                x1: run.x1,
+                polygon: run.poly,
+                lit: pieces,
+                asked_stage: asked,
+                decision,
+            });
+        }
+    }
+    Ok(LineTrace { line, shadows: shadows.name().into(), entering, leaving, active, spans, runs, decisions })
+}
+
+impl LineTrace {
+    /// The trace as readable text; `x` restricts spans, runs and decisions to that pixel.
+    pub fn text(&self, scene: &Scene, x: Option<u32>) -> String {
+        let face = |p: u32| scene.polygons[p as usize].face;
+        let keep = |a: u32, b: u32| x.is_none_or(|x| a <= x && x < b);
+        let mut t = String::new();
+        let _ = writeln!(t, "line {} (sampled at y = {}.5), shadows: {}", self.line, self.line, self.shadows);
+        let _ = writeln!(t, "\nedge table: {} edge(s) enter, {} leave", self.entering.len(), self.leaving.len());
+        for (what, list) in [("enters", &self.entering), ("leaves", &self.leaving)] {
+            for e in list {
+                let _ = writeln!(
+                    t,
+                    "  {what}: polygon {} (face {}), lines {}..{}, top ({:.3}, {:.3}), dx/dy {:.4}",
+                    e.polygon, e.face, e.first_line, e.end_line, e.top.0, e.top.1, e.dxdy
+                );
+            }
+        }
+        let _ = writeln!(t, "\nactive edge table ({} crossings, by x):", self.active.len());
+        for (cx, p) in &self.active {
+            let _ = writeln!(t, "  x = {cx:.4}  polygon {p} (face {})", face(*p));
+        }
+        let _ = writeln!(t, "\nspans:");
+        for s in self.spans.iter().filter(|s| keep(s.x0, s.x1)) {
+            let cover: Vec<String> =
+                s.covering.iter().map(|c| format!("face {} (1/z {:.4} .. {:.4})", c.1, c.2, c.3)).collect();
+            let verdict = match s.split_at {
+                Some(m) => format!(
+                    "nearest differs at the ends (faces {} and {}): split at {m}",
+                    face(s.nearest.0),
+                    face(s.nearest.1)
+                ),
+                None => format!("face {} nearest at both ends: wins", face(s.nearest.0)),
+            };
+            let _ = writeln!(
+                t,
+                "  {}{}..{}: [{}] -> {verdict}",
+                "  ".repeat(s.depth as usize),
+                s.x0,
+                s.x1,
+                cover.join(", ")
+            );
+        }
+        let _ = writeln!(t, "\nruns:");
+        for r in self.runs.iter().filter(|r| keep(r.x0, r.x1)) {
+            let _ = writeln!(t, "  {}..{}: polygon {} (face {})", r.x0, r.x1, r.poly, face(r.poly));
+        }
+        let _ = writeln!(t, "\nshadow decisions:");
+        for d in self.decisions.iter().filter(|d| keep(d.x0, d.x1)) {
+            let pieces: Vec<String> = d.lit.iter().map(|(a, b, v)| format!("{a}..{b}: {v}")).collect();
+            let _ = writeln!(
+                t,
+                "  run {}..{} light {} sample {}: lit [{}]; {}",
+                d.x0,
+                d.x1,
+                d.light,
+                d.sample,
+                pieces.join(", "),
+                d.decision.note
+            );
+        }
+        t
+    }
+}

@@ -1,0 +1,144 @@
+//! The study tools: compare's report, trace against a hand-worked scanline, scale's files.
+
+use std::path::Path;
+use umbra::study::compare::{compare, CompareOptions};
+use umbra::{Scene, ShadowMethod};
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("umbra-study-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn compare_reports_every_method_and_a_valid_page() {
+    let mut scene = Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/lights.toml")).unwrap();
+    scene.camera.width = 160;
+    scene.camera.height = 120;
+    let out = tmp("compare");
+    let opts = CompareOptions { runs: 1, out: out.clone(), ..CompareOptions::default() };
+    let report = compare(&scene, "lights", &opts).unwrap();
+    assert_eq!(report.results.len(), umbra::VisibilityMethod::ALL.len() * ShadowMethod::ALL.len());
+    for r in &report.results {
+        let m: ShadowMethod = r.shadows.parse().unwrap();
+        match m {
+            ShadowMethod::Planar => assert!(r.status.starts_with("not applicable"), "{}", r.status),
+            _ if m.is_exact() => {
+                assert_eq!((r.status.as_str(), r.wrong_pixels), ("ok", 0), "{} + {}", r.visibility, r.shadows)
+            }
+            _ => assert!(r.interior_pixels > 1000 && r.status == "ok", "{} + {}", r.visibility, r.shadows),
+        }
+    }
+    // The approximate methods' error is measured, not assumed: none leaves shadows out.
+    assert!(report.results.iter().any(|r| r.shadows == "none" && r.wrong_pixels > 100));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let doc = scraper::Html::parse_document(&html);
+    assert!(doc.errors.is_empty(), "HTML parse errors: {:?}", doc.errors);
+    let imgs = scraper::Selector::parse("img").unwrap();
+    let mut n = 0;
+    for img in doc.select(&imgs) {
+        let src = img.value().attr("src").unwrap();
+        assert!(out.join(src).exists(), "{src} is linked but missing");
+        n += 1;
+    }
+    assert!(n > 20);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    assert_eq!(json["results"].as_array().unwrap().len(), report.results.len());
+    assert_eq!(std::fs::read_to_string(out.join("results.csv")).unwrap().lines().count(), report.results.len() + 1);
+}
+
+/// A hand-worked scanline. The camera at the origin looks down −z with a 90° field of view
+/// on a 16×8 image (aspect 2), so a point (x, y) at depth d lands at
+/// X = (x/d/2 + 1)·8, Y = (1 − y/d)·4. Quad A at depth 1 spans x −1..0.5, y −0.5..0.5: X 4..10,
+/// Y 2..6. Quad B at depth 2 spans x 0..2, y −1..1: x/d 0..1, X 8..12, Y 2..6. On line 3
+/// (y = 3.5) the active edges cross at 4 and 10 (A) and 8 and 12 (B); the spans are 4..8
+/// {A}, 8..10 {A, B} where A (1/z = 1) beats B (1/z = 0.5) at both ends, and 10..12 {B};
+/// the runs are 4..10 on A and 10..12 on B.
+#[test]
+fn trace_matches_a_hand_worked_line() {
+    let src = "[camera]\neye = [0.0, 0.0, 0.0]\ntarget = [0.0, 0.0, -1.0]\nfov_y = 90.0\nwidth = 16\nheight = 8\n\
+               [[light]]\nkind = \"point\"\nposition = [0.0, 0.0, 0.5]\n\
+               [[object]]\npolygons = [\n [[-1.0,-0.5,-1.0],[0.5,-0.5,-1.0],[0.5,0.5,-1.0],[-1.0,0.5,-1.0]],\n \
+               [[0.0,-1.0,-2.0],[2.0,-1.0,-2.0],[2.0,1.0,-2.0],[0.0,1.0,-2.0]],\n]\n";
+    let scene = Scene::from_toml(src, Path::new("t.toml"), Path::new(".")).unwrap();
+    let t = umbra::study::trace::trace(&scene, 3, ShadowMethod::BouknightKelley, &Default::default()).unwrap();
+    let xs: Vec<(f64, u32)> = t.active.clone();
+    let want = [(4.0, 0), (8.0, 1), (10.0, 0), (12.0, 1)];
+    assert_eq!(xs.len(), 4);
+    for ((x, p), (wx, wp)) in xs.iter().zip(want) {
+        assert!((x - wx).abs() < 1e-9 && *p == wp, "{xs:?}");
+    }
+    let spans: Vec<String> = t
+        .spans
+        .iter()
+        .map(|s| {
+            format!("{}..{} covered by {} nearest {:?} split {:?}", s.x0, s.x1, s.covering.len(), s.nearest, s.split_at)
+        })
+        .collect();
+    assert_eq!(
+        spans,
+        [
+            "4..8 covered by 1 nearest (0, 0) split None",
+            "8..10 covered by 2 nearest (0, 0) split None",
+            "10..12 covered by 1 nearest (1, 1) split None"
+        ]
+    );
+    let middle = &t.spans[1].covering;
+    assert!((middle[0].2 - 1.0).abs() < 1e-9 || (middle[1].2 - 1.0).abs() < 1e-9);
+    assert!(middle.iter().any(|c| c.0 == 1 && (c.2 - 0.5).abs() < 1e-9));
+    let runs: Vec<(u32, u32, u32)> = t.runs.iter().map(|r| (r.x0, r.x1, r.poly)).collect();
+    assert_eq!(runs, vec![(4, 10, 0), (10, 12, 1)]);
+    // Edges: both quads' side edges cover lines 2..6; none enter or leave on line 3.
+    assert!(t.entering.is_empty() && t.leaving.is_empty());
+    // The light (between the eye and A) casts A's shadow onto B: B's run is shadowed where
+    // A's projection from the light covers it, and the decision says what it examined.
+    assert_eq!(t.decisions.len(), 2);
+    let on_b = &t.decisions[1];
+    assert_eq!(on_b.polygon, 1);
+    assert!(on_b.decision.note.contains("shadow polygon(s)"), "{}", on_b.decision.note);
+    let text = t.text(&scene, None);
+    assert!(text.contains("8..10: [face 0 (1/z 1.0000 .. 1.0000), face 1 (1/z 0.5000 .. 0.5000)] -> face 0 nearest at both ends: wins"), "{text}");
+}
+
+#[test]
+fn scale_writes_csv_and_plots() {
+    use umbra::study::scale::{scale, ScaleOptions, Sweep};
+    let out = tmp("scale");
+    let opts = ScaleOptions {
+        sweep: Sweep::Quads,
+        values: vec![1.0, 4.0, 16.0],
+        methods: vec![
+            (umbra::VisibilityMethod::Scanline, ShadowMethod::None),
+            (umbra::VisibilityMethod::ZBuffer, ShadowMethod::None),
+        ],
+        shadow_options: Default::default(),
+        runs: 1,
+        width: 160,
+        height: 90,
+        count: 10,
+        size: 0.3,
+        counter: "visibility.depth_tests".into(),
+        out: out.clone(),
+    };
+    let points = scale(&opts).unwrap();
+    assert_eq!(points.len(), 6);
+    // The z-buffer tests every covered pixel once per polygon: its depth tests grow with depth
+    // complexity, about 160×90 per quad.
+    let z: Vec<u64> = points.iter().filter(|p| p.visibility == "zbuffer").map(|p| p.counter).collect();
+    assert!(z[2] > 10 * z[0], "{z:?}");
+    assert_eq!(std::fs::read_to_string(out.join("scale.csv")).unwrap().lines().count(), 7);
+    for svg in ["time.svg", "counter.svg"] {
+        assert!(std::fs::read_to_string(out.join(svg)).unwrap().starts_with("<svg"));
+    }
+}
+
+#[test]
+fn unknown_method_names_list_the_known_ones() {
+    let e = "magic".parse::<ShadowMethod>().unwrap_err().to_string();
+    for m in ShadowMethod::ALL {
+        assert!(e.contains(m.name()), "{e}");
+    }
+    let e = "painter".parse::<umbra::VisibilityMethod>().unwrap_err().to_string();
+    assert!(e.contains("scanline") && e.contains("zbuffer"), "{e}");
+}
