@@ -23,6 +23,9 @@ pub struct Frame {
     pub light: Vec<Vec<f32>>,
     /// Per-pixel counters, when the render was asked for them.
     pub counters: Option<PixelCounters>,
+    /// Where a mirror is seen: the face id seen in it (same encoding as `id`); `None` when
+    /// no mirror was seen from the front.
+    pub mirror_id: Option<Vec<u32>>,
 }
 
 /// Per-pixel counters (`--aov` writes them as false-colour images).
@@ -47,6 +50,7 @@ impl Frame {
             id: vec![BACKGROUND; n],
             light: vec![vec![0.0; n]; lights],
             counters: None,
+            mirror_id: None,
         }
     }
 
@@ -70,9 +74,11 @@ impl Frame {
 
     /// `id.png`: the face id as a little-endian u32 in R, G, B, A.
     pub fn id_image(&self) -> image::RgbaImage {
-        image::RgbaImage::from_fn(self.width, self.height, |x, y| {
-            image::Rgba(self.id[(y * self.width + x) as usize].to_le_bytes())
-        })
+        Self::ids_image(&self.id, self.width, self.height)
+    }
+
+    fn ids_image(ids: &[u32], width: u32, height: u32) -> image::RgbaImage {
+        image::RgbaImage::from_fn(width, height, |x, y| image::Rgba(ids[(y * width + x) as usize].to_le_bytes()))
     }
 
     /// `light<k>.png`: `round(255 * lit fraction)`.
@@ -116,7 +122,8 @@ impl Frame {
         self.save(self.color_image(gamma).into(), path)
     }
 
-    /// Writes `id.png` and `light<k>.png` into `dir` (created if missing), and, when the
+    /// Writes `id.png` and `light<k>.png` into `dir` (created if missing), `mirror_id.png`
+    /// when a mirror was seen, and, when the
     /// frame has per-pixel counters, `depth_complexity.png`, `span_splits.png` and
     /// `shadow_tests.png` in false colour with a legend.
     pub fn save_aovs(&self, dir: &Path) -> Result<()> {
@@ -124,6 +131,9 @@ impl Frame {
         self.save(self.id_image().into(), &dir.join("id.png"))?;
         for k in 0..self.light.len() {
             self.save(self.light_image(k).into(), &dir.join(format!("light{k}.png")))?;
+        }
+        if let Some(m) = &self.mirror_id {
+            self.save(Self::ids_image(m, self.width, self.height).into(), &dir.join("mirror_id.png"))?;
         }
         if let Some(c) = &self.counters {
             for (name, values) in [

@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use umbra::reflection::ReflectionMethod;
 use umbra::shadow::volumes::Counting;
 use umbra::shadow::{ShadowFilter, ShadowOptions, WilliamsOptions};
 use umbra::study::compare::{compare, CompareOptions};
@@ -129,6 +130,10 @@ struct RenderArgs {
     /// (shadow polygons, lit detail polygons, shadow-volume polygons).
     #[arg(long, value_enum)]
     debug: Option<Debug>,
+    /// Planar mirrors (materials with mirror > 0): reflect the scene and lights (scene,
+    /// seed 003's method 2), reflect the eye (eye, method 1), or render mirrors plainly (off).
+    #[arg(long, default_value = "scene", value_parser = parse::<ReflectionMethod>)]
+    reflection: ReflectionMethod,
 }
 
 #[derive(clap::Args)]
@@ -299,6 +304,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
                 shadow_options: a.shadow.options(a.debug.is_some())?,
                 progress: true,
                 pixel_counters: a.aov.is_some(),
+                reflection: a.reflection,
             };
             let out = render(&scene, &opts)?;
             let mut img = out.frame.color_image(a.gamma);

@@ -34,6 +34,8 @@ pub struct RenderOptions {
     pub progress: bool,
     /// Collect per-pixel counters into [`Frame::counters`].
     pub pixel_counters: bool,
+    /// How mirrors are rendered.
+    pub reflection: crate::reflection::ReflectionMethod,
 }
 
 impl Default for RenderOptions {
@@ -44,6 +46,7 @@ impl Default for RenderOptions {
             shadow_options: ShadowOptions::default(),
             progress: false,
             pixel_counters: false,
+            reflection: crate::reflection::ReflectionMethod::default(),
         }
     }
 }
@@ -218,6 +221,11 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     stats.time_ms.insert("total", ms(start.elapsed()));
     frame.counters = pixel_counters;
     let outlines = shadows.outlines();
+    let t = Instant::now();
+    crate::reflection::add_reflections(scene, opts, &mut frame, &runs)?;
+    if frame.mirror_id.is_some() {
+        stats.time_ms.insert("reflections", ms(t.elapsed()));
+    }
     Ok(Rendered { frame, stats, outlines })
 }
 

@@ -124,6 +124,7 @@ struct RawMaterial {
     model: Option<SpecularModel>,
     roughness: Option<Num>,
     fresnel: Option<Num>,
+    mirror: Option<Num>,
     shading: Option<ShadingMode>,
 }
 
@@ -238,11 +239,16 @@ impl Scene {
                 model: m.model.unwrap_or(d.model),
                 roughness: m.roughness.map_or(d.roughness, |x| x.0 as f32),
                 fresnel: m.fresnel.map_or(d.fresnel, |x| x.0 as f32),
+                mirror: m.mirror.map_or(d.mirror, |x| x.0 as f32),
                 shading: m.shading.unwrap_or(d.shading),
                 ..d
             };
-            if mat.roughness <= 0.0 || mat.shininess < 0.0 || !(0.0..=1.0).contains(&mat.fresnel) {
-                return Err(cx.err(span, "roughness must be > 0, shininess >= 0 and fresnel in [0, 1]"));
+            if mat.roughness <= 0.0
+                || mat.shininess < 0.0
+                || !(0.0..=1.0).contains(&mat.fresnel)
+                || !(0.0..=1.0).contains(&mat.mirror)
+            {
+                return Err(cx.err(span, "roughness must be > 0, shininess >= 0, fresnel and mirror in [0, 1]"));
             }
             materials.push(mat);
         }

@@ -131,6 +131,8 @@ pub struct Material {
     pub roughness: f32,
     /// Cook-Torrance Fresnel reflectance at normal incidence F0 (Schlick); default 0.04.
     pub fresnel: f32,
+    /// Planar mirror reflectance (0: not a mirror); its front side reflects.
+    pub mirror: f32,
     /// Shading mode.
     pub shading: ShadingMode,
 }
@@ -149,6 +151,7 @@ impl Material {
             model: SpecularModel::Phong,
             roughness: 0.3,
             fresnel: 0.04,
+            mirror: 0.0,
             shading: ShadingMode::Flat,
         }
     }

@@ -54,8 +54,8 @@ impl Scene {
             };
             let _ = writeln!(
                 t,
-                "\n[[material]]\nname = {:?}\ncolor = {}\nspecular_color = {}\nka = {:?}\nkd = {:?}\nks = {:?}\nshininess = {:?}\nmodel = \"{model}\"\nroughness = {:?}\nfresnel = {:?}\nshading = \"{shading}\"",
-                m.name, f3(m.color), f3(m.specular_color), m.ka, m.kd, m.ks, m.shininess, m.roughness, m.fresnel
+                "\n[[material]]\nname = {:?}\ncolor = {}\nspecular_color = {}\nka = {:?}\nkd = {:?}\nks = {:?}\nshininess = {:?}\nmodel = \"{model}\"\nroughness = {:?}\nfresnel = {:?}\nmirror = {:?}\nshading = \"{shading}\"",
+                m.name, f3(m.color), f3(m.specular_color), m.ka, m.kd, m.ks, m.shininess, m.roughness, m.fresnel, m.mirror
             );
         }
         for l in &self.lights {
