@@ -50,6 +50,10 @@ struct ShadowArgs {
     /// eye is in shadow).
     #[arg(long, default_value = "zpass", value_parser = parse::<Counting>)]
     crow_count: Counting,
+    /// Crow and stencil-volume: give every polygon its own volume instead of building closed
+    /// meshes' volumes on their silhouettes (to measure what silhouettes save).
+    #[arg(long)]
+    no_silhouettes: bool,
     /// Williams: texels along each side of a shadow map.
     #[arg(long, default_value_t = 2048)]
     map_size: u32,
@@ -84,6 +88,7 @@ impl ShadowArgs {
         Ok(ShadowOptions {
             prefilter: !self.no_prefilter,
             crow_count: self.crow_count,
+            silhouettes: !self.no_silhouettes,
             williams: WilliamsOptions {
                 map_size: self.map_size,
                 bias: self.bias,

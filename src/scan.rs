@@ -42,6 +42,8 @@ pub struct Crossing {
     pub x: f64,
     /// The tag of the polygon the edge belongs to.
     pub tag: u32,
+    /// The edge (its index in the table).
+    edge: u32,
 }
 
 /// The first pixel whose centre lies at or right of `x`, clamped to `0..=width`:
@@ -193,10 +195,9 @@ pub struct ActiveEdges<'a> {
     table: &'a EdgeTable,
     next: u32,
     end: u32,
-    active: Vec<(Crossing, u32)>,
-    incoming: Vec<(Crossing, u32)>,
-    merged: Vec<(Crossing, u32)>,
-    out: Vec<Crossing>,
+    active: Vec<Crossing>,
+    incoming: Vec<Crossing>,
+    merged: Vec<Crossing>,
     current: Option<u32>,
     /// Edges that entered so far (a counter for the stats).
     pub entered: u64,
@@ -214,10 +215,10 @@ impl<'a> ActiveEdges<'a> {
             let upto = table.bucket[(start - table.lines.start) as usize] as usize;
             for (i, e) in table.edges[..upto].iter().enumerate() {
                 if e.end > start {
-                    active.push((Crossing { x: e.x_at(start), tag: e.tag }, i as u32));
+                    active.push(Crossing { x: e.x_at(start), tag: e.tag, edge: i as u32 });
                 }
             }
-            active.sort_unstable_by(|a, b| a.0.x.total_cmp(&b.0.x));
+            active.sort_unstable_by(|a, b| a.x.total_cmp(&b.x));
         }
         ActiveEdges {
             table,
@@ -226,7 +227,6 @@ impl<'a> ActiveEdges<'a> {
             active,
             incoming: Vec::new(),
             merged: Vec::new(),
-            out: Vec::new(),
             current: None,
             entered: 0,
         }
@@ -240,17 +240,24 @@ impl<'a> ActiveEdges<'a> {
         let line = self.next;
         self.next += 1;
         let edges = &self.table.edges;
-        // Edges whose last line has passed leave; the others step to this line.
-        self.active.retain(|&(_, i)| edges[i as usize].end > line);
-        for (c, i) in &mut self.active {
-            c.x = edges[*i as usize].x_at(line);
+        // Edges whose last line has passed leave; the others step to this line (one pass).
+        let mut kept = 0;
+        for i in 0..self.active.len() {
+            let mut c = self.active[i];
+            let e = &edges[c.edge as usize];
+            if e.end > line {
+                c.x = e.x_at(line);
+                self.active[kept] = c;
+                kept += 1;
+            }
         }
+        self.active.truncate(kept);
         // Insertion sort: the list was sorted on the previous line, and only edges that
         // cross each other between two lines are out of order now.
         for i in 1..self.active.len() {
             let item = self.active[i];
             let mut j = i;
-            while j > 0 && self.active[j - 1].0.x > item.0.x {
+            while j > 0 && self.active[j - 1].x > item.x {
                 self.active[j] = self.active[j - 1];
                 j -= 1;
             }
@@ -262,16 +269,18 @@ impl<'a> ActiveEdges<'a> {
         if !entering.is_empty() {
             self.entered += entering.len() as u64;
             self.incoming.clear();
-            self.incoming.extend(
-                entering.iter().enumerate().map(|(k, e)| (Crossing { x: e.x_at(line), tag: e.tag }, base + k as u32)),
-            );
-            self.incoming.sort_unstable_by(|a, b| a.0.x.total_cmp(&b.0.x));
+            self.incoming.extend(entering.iter().enumerate().map(|(k, e)| Crossing {
+                x: e.x_at(line),
+                tag: e.tag,
+                edge: base + k as u32,
+            }));
+            self.incoming.sort_unstable_by(|a, b| a.x.total_cmp(&b.x));
             self.merged.clear();
             let (mut a, mut b) = (self.active.iter().peekable(), self.incoming.iter().peekable());
             loop {
                 let next = match (a.peek(), b.peek()) {
                     (Some(x), Some(y)) => {
-                        if y.0.x < x.0.x {
+                        if y.x < x.x {
                             b.next()
                         } else {
                             a.next()
@@ -285,10 +294,8 @@ impl<'a> ActiveEdges<'a> {
             }
             std::mem::swap(&mut self.active, &mut self.merged);
         }
-        self.out.clear();
-        self.out.extend(self.active.iter().map(|&(c, _)| c));
         self.current = Some(line);
-        Some((line, &self.out))
+        Some((line, &self.active))
     }
 
     /// Steps forward to `line` (which must not be behind the last line walked) and gives its
@@ -296,7 +303,7 @@ impl<'a> ActiveEdges<'a> {
     pub fn advance_to(&mut self, line: u32) -> &[Crossing] {
         while self.next <= line && self.next_line().is_some() {}
         if self.current == Some(line) {
-            &self.out
+            &self.active
         } else {
             &[]
         }
@@ -304,8 +311,7 @@ impl<'a> ActiveEdges<'a> {
 
     /// Bytes held by the walker.
     pub fn bytes(&self) -> usize {
-        self.active.capacity() * std::mem::size_of::<(Crossing, u32)>()
-            + self.out.capacity() * std::mem::size_of::<Crossing>()
+        (self.active.capacity() + self.incoming.capacity() + self.merged.capacity()) * std::mem::size_of::<Crossing>()
     }
 
     /// Number of edges active on the current line.

@@ -50,7 +50,7 @@ impl<'a> Crow<'a> {
     pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
         let counting = ctx.options.crow_count;
         let view = ctx.view;
-        let adjacency = Adjacency::new(ctx.scene);
+        let adjacency = Adjacency::new(ctx.scene, ctx.options.silhouettes);
         let samples = ctx
             .all_samples()
             .map(|(_, _, sample)| {

@@ -95,8 +95,8 @@ impl OverlayWalker<'_> {
         let xs = self.aet.advance_to(line);
         self.grouped.clear();
         self.grouped.extend(xs.iter().map(|c| (self.overlay.receiver[c.tag as usize], c.x, c.tag)));
-        // Stable: crossings of one receiver stay in x order.
-        self.grouped.sort_by_key(|g| g.0);
+        // By receiver, then x (the crossings' own order).
+        self.grouped.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     }
 
     /// Writes into `out` the intervals of the current line where the overlay polygons on

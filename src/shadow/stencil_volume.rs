@@ -34,7 +34,7 @@ impl<'a> StencilVolume<'a> {
             }
         }
         let planes: Vec<Option<DepthPlane>> = scene.polygons.iter().map(|p| view.depth_plane(&p.plane)).collect();
-        let adjacency = Adjacency::new(scene);
+        let adjacency = Adjacency::new(scene, ctx.options.silhouettes);
         let counting = ctx.options.crow_count;
         let band = crate::render::band_height(h);
         let mut writes = 0u64;

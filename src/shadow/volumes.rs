@@ -264,8 +264,9 @@ type Edge = (usize, usize, DVec3, DVec3);
 
 impl Adjacency {
     /// The adjacency of the scene's shadow-casting polygons, by object. Vertices are welded
-    /// by exact position.
-    pub fn new(scene: &crate::Scene) -> Self {
+    /// by exact position. Without `silhouettes`, every object is treated as open (one volume
+    /// per polygon).
+    pub fn new(scene: &crate::Scene, silhouettes: bool) -> Self {
         let casters: Vec<usize> = (0..scene.polygons.len()).filter(|&i| scene.casts_shadows(i)).collect();
         // Weld: one id per distinct position, by sorting.
         let mut keys: Vec<([u64; 3], u32)> = Vec::new();
@@ -296,7 +297,7 @@ impl Adjacency {
         let objects = objects
             .into_iter()
             .map(|(_, polys)| {
-                let edges = closed_edges(scene, &polys, &id);
+                let edges = if silhouettes { closed_edges(scene, &polys, &id) } else { None };
                 (polys, edges)
             })
             .collect();

@@ -1,0 +1,96 @@
+//! Shadow stages at 1920×1080, each beside the same render without shadows: the 10×10
+//! cubes scene (1,201 polygons), spheres of 10k and 100k triangles, stacked quads. The
+//! Atherton-Weiler-Greenberg group separates pass 1 (the database), the view pass with a
+//! prebuilt database, and ten views of one database.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use std::sync::Arc;
+use std::time::Duration;
+use umbra::shadow::{ShadowDatabase, ShadowOptions};
+use umbra::{generate, render, Counters, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
+
+const W: u32 = 1920;
+const H: u32 = 1080;
+
+fn opts(shadows: ShadowMethod, shadow_options: ShadowOptions) -> RenderOptions {
+    RenderOptions { visibility: VisibilityMethod::Scanline, shadows, shadow_options, ..RenderOptions::default() }
+}
+
+fn group<'a>(c: &'a mut Criterion, name: &str) -> criterion::BenchmarkGroup<'a, criterion::measurement::WallTime> {
+    let mut g = c.benchmark_group(name);
+    g.sample_size(10).measurement_time(Duration::from_secs(4)).warm_up_time(Duration::from_millis(500));
+    g
+}
+
+fn stages(c: &mut Criterion) {
+    let scenes: Vec<(&str, Scene)> = vec![
+        ("cubes10", generate::cubes(10, true, W, H).unwrap()),
+        ("sphere10k", generate::spheres(10_000, 1, W, H).unwrap()),
+        ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap()),
+        ("quads16", generate::stacked_quads(16, W, H).unwrap()),
+    ];
+    let mut g = group(c, "shadows");
+    for (name, scene) in &scenes {
+        let mut methods = vec![
+            ("none", ShadowMethod::None, ShadowOptions::default()),
+            ("bouknight-kelley", ShadowMethod::BouknightKelley, ShadowOptions::default()),
+            ("crow", ShadowMethod::Crow, ShadowOptions::default()),
+            ("williams-2048", ShadowMethod::Williams, ShadowOptions::default()),
+            ("stencil-volume", ShadowMethod::StencilVolume, ShadowOptions::default()),
+            ("ray-cast", ShadowMethod::RayCast, ShadowOptions::default()),
+        ];
+        if *name != "sphere100k" {
+            methods.push((
+                "atherton-weiler-greenberg",
+                ShadowMethod::AthertonWeilerGreenberg,
+                ShadowOptions::default(),
+            ));
+            methods.push((
+                "bouknight-kelley-no-prefilter",
+                ShadowMethod::BouknightKelley,
+                ShadowOptions { prefilter: false, ..Default::default() },
+            ));
+        }
+        for (label, m, o) in methods {
+            let o = opts(m, o);
+            g.bench_with_input(BenchmarkId::new(label, name), scene, |b, s| b.iter(|| render(s, &o).unwrap()));
+        }
+    }
+    g.finish();
+}
+
+fn atherton_weiler_greenberg(c: &mut Criterion) {
+    let mut g = group(c, "awg");
+    for (name, scene) in [
+        ("cubes10", generate::cubes(10, true, W, H).unwrap()),
+        ("sphere10k", generate::spheres(10_000, 1, W, H).unwrap()),
+    ] {
+        g.bench_function(BenchmarkId::new("pass1", name), |b| {
+            b.iter(|| ShadowDatabase::build(&scene, 0, &mut Counters::default()).unwrap())
+        });
+        let db = Arc::new(vec![ShadowDatabase::build(&scene, 0, &mut Counters::default()).unwrap()]);
+        let view_pass = opts(
+            ShadowMethod::AthertonWeilerGreenberg,
+            ShadowOptions { awg_database: Some(db.clone()), ..Default::default() },
+        );
+        g.bench_function(BenchmarkId::new("view-pass", name), |b| b.iter(|| render(&scene, &view_pass).unwrap()));
+        let mut views = Vec::new();
+        for k in 0..10 {
+            let mut s = scene.clone();
+            let a = k as f64 * 0.2;
+            s.camera.eye = glam::DVec3::new(
+                s.camera.eye.x * a.cos() - s.camera.eye.z * a.sin(),
+                s.camera.eye.y,
+                s.camera.eye.x * a.sin() + s.camera.eye.z * a.cos(),
+            );
+            views.push(s);
+        }
+        g.bench_function(BenchmarkId::new("ten-views-one-database", name), |b| {
+            b.iter(|| views.iter().map(|s| render(s, &view_pass).unwrap().stats.polygons).sum::<usize>())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, stages, atherton_weiler_greenberg);
+criterion_main!(benches);

@@ -1,0 +1,30 @@
+//! Builds one Atherton-Weiler-Greenberg shadow database for a scene's first light and
+//! renders it from the scene's camera and from a second viewpoint, the lit detail polygons
+//! drawn over each image: `cargo run --release --example awg_views SCENE OUT_DIR`.
+use std::sync::Arc;
+use umbra::shadow::{ShadowDatabase, ShadowOptions};
+use umbra::{render, Counters, Frame, RenderOptions, Scene, ShadowMethod};
+
+fn main() -> umbra::Result<()> {
+    let args: Vec<String> = std::env::args().collect();
+    let (scene_path, out) = (&args[1], std::path::Path::new(&args[2]));
+    let mut scene = Scene::load(scene_path)?;
+    let mut counters = Counters::default();
+    let db = Arc::new(vec![ShadowDatabase::build(&scene, 0, &mut counters)?]);
+    println!("{}", serde_json::to_string(&counters).unwrap_or_default());
+    let opts = RenderOptions {
+        shadows: ShadowMethod::AthertonWeilerGreenberg,
+        shadow_options: ShadowOptions { awg_database: Some(db), keep_outlines: true, ..Default::default() },
+        ..Default::default()
+    };
+    std::fs::create_dir_all(out).map_err(|e| umbra::Error::Io { path: out.to_owned(), source: e })?;
+    for (name, eye) in [("awg-detail", scene.camera.eye), ("awg-second-view", glam::DVec3::new(-4.0, 6.0, 5.0))] {
+        scene.camera.eye = eye;
+        let r = render(&scene, &opts)?;
+        let mut img = r.frame.color_image(None);
+        Frame::draw_outlines(&mut img, &r.outlines, [255, 40, 200]);
+        let path = out.join(format!("{name}.png"));
+        img.save(&path).map_err(|e| umbra::Error::Image { path, source: e })?;
+    }
+    Ok(())
+}
