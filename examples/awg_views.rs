@@ -18,7 +18,7 @@ fn main() -> umbra::Result<()> {
         ..Default::default()
     };
     std::fs::create_dir_all(out).map_err(|e| umbra::Error::Io { path: out.to_owned(), source: e })?;
-    for (name, eye) in [("awg-detail", scene.camera.eye), ("awg-second-view", glam::DVec3::new(-4.0, 6.0, 5.0))] {
+    for (name, eye) in [("awg-detail", scene.camera.eye), ("awg-second-view", glam::DVec3::new(2.2, 4.8, 2.6))] {
         scene.camera.eye = eye;
         let r = render(&scene, &opts)?;
         let mut img = r.frame.color_image(None);

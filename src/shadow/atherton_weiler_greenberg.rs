@@ -5,7 +5,7 @@
 //!    light's view: a perspective view for point, spot and area-light samples, split into the
 //!    six 90° faces of a cube around the light so nothing is lost at the seams; a parallel
 //!    view for a directional light. (b) The visible parts are found by Weiler & Atherton's
-//!    area sorting ([`visible`]): a rough depth sort, then the front polygon's outline clips
+//!    area sorting (`visible`): a rough depth sort, then the front polygon's outline clips
 //!    everything into inside and outside lists ([`crate::geometry::weiler_atherton`]); what
 //!    lies inside and behind it is hidden, and when something inside lies in front after all
 //!    (the sort was wrong) that part is resolved first, recursively. (c) The visible
