@@ -23,16 +23,15 @@
 //! from a sort that leaves its sibling pieces out. Area lights get one database
 //! per sample; the lit fraction is the share of samples that light a point.
 
-use super::overlay::{Interval, Overlay, OverlayWalker};
+use super::overlay::{CoverWalker, Overlay};
 use super::projection::edge_on;
-use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
+use super::{ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::weiler_atherton::{clip, ClipError, Region};
 use crate::geometry::{clip_polygon, Plane};
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
-use crate::visibility::Run;
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -495,46 +494,10 @@ impl<'a> AthertonWeilerGreenberg<'a> {
 
 impl ShadowStage for AthertonWeilerGreenberg<'_> {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
-        Box::new(Walker {
-            stage: self,
-            walkers: self.detail.iter().map(|o| o.walker(0..self.ctx.view.height)).collect(),
-            intervals: Vec::new(),
-        })
+        Box::new(CoverWalker::new(self.ctx, &self.detail, 1.0, 0.0, "lit detail polygon"))
     }
 
     fn outlines(&self) -> Vec<Vec<DVec2>> {
         self.detail.first().map_or_else(Vec::new, |o| o.rings().to_vec())
-    }
-}
-
-struct Walker<'s> {
-    stage: &'s AthertonWeilerGreenberg<'s>,
-    walkers: Vec<OverlayWalker<'s>>,
-    intervals: Vec<Interval>,
-}
-
-impl ShadowWalker for Walker<'_> {
-    fn start_line(&mut self, line: u32) {
-        for w in &mut self.walkers {
-            w.advance_to(line);
-        }
-    }
-
-    fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
-        lit.fill(0.0);
-        let k = self.stage.ctx.sample_index(light, sample);
-        self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut self.intervals);
-        for iv in &self.intervals {
-            lit[(iv.start - run.x0) as usize..(iv.end - run.x0) as usize].fill(1.0);
-        }
-    }
-
-    fn decision(&self) -> Decision {
-        let on: Vec<String> =
-            self.intervals.iter().map(|i| format!("#{} covers {}..{}", i.tag, i.start, i.end)).collect();
-        Decision {
-            tested: self.intervals.iter().map(|i| (i.start, i.end, 1)).collect(),
-            note: format!("{} lit detail polygon(s) on this polygon cover [{}]", self.intervals.len(), on.join(", ")),
-        }
     }
 }

@@ -5,7 +5,9 @@
 //! Each line, the crossings are grouped by receiver; for a visible run on receiver B the
 //! walker gives the pixel intervals where each of B's overlay polygons covers the run.
 
+use super::{Decision, ShadowContext, ShadowWalker};
 use crate::scan::{boundary, ActiveEdges, EdgeTable};
+use crate::visibility::Run;
 use glam::DVec2;
 use std::ops::Range;
 
@@ -120,5 +122,58 @@ impl OverlayWalker<'_> {
             }
         }
         out.sort_unstable_by_key(|i| (i.start, i.end));
+    }
+}
+
+/// A shadow walker that answers by coverage alone: the pixels of a run that its polygon's
+/// overlay polygons cover get `inside`, the others `outside`. Atherton-Weiler-Greenberg's
+/// view pass (lit where detail polygons cover) and Blinn's planar shadows (dark where a
+/// flattened caster covers) are both this.
+pub struct CoverWalker<'a> {
+    ctx: &'a ShadowContext<'a>,
+    walkers: Vec<OverlayWalker<'a>>,
+    intervals: Vec<Interval>,
+    inside: f32,
+    outside: f32,
+    what: &'static str,
+}
+
+impl<'a> CoverWalker<'a> {
+    /// A walker over one overlay per light sample (`overlays[sample_index(l, s)]`).
+    pub fn new(
+        ctx: &'a ShadowContext<'a>,
+        overlays: &'a [Overlay],
+        inside: f32,
+        outside: f32,
+        what: &'static str,
+    ) -> Self {
+        let walkers = overlays.iter().map(|o| o.walker(0..ctx.view.height)).collect();
+        CoverWalker { ctx, walkers, intervals: Vec::new(), inside, outside, what }
+    }
+}
+
+impl ShadowWalker for CoverWalker<'_> {
+    fn start_line(&mut self, line: u32) {
+        for w in &mut self.walkers {
+            w.advance_to(line);
+        }
+    }
+
+    fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
+        lit.fill(self.outside);
+        let k = self.ctx.sample_index(light, sample);
+        self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut self.intervals);
+        for iv in &self.intervals {
+            lit[(iv.start - run.x0) as usize..(iv.end - run.x0) as usize].fill(self.inside);
+        }
+    }
+
+    fn decision(&self) -> Decision {
+        let on: Vec<String> =
+            self.intervals.iter().map(|i| format!("#{} covers {}..{}", i.tag, i.start, i.end)).collect();
+        Decision {
+            tested: self.intervals.iter().map(|i| (i.start, i.end, 1)).collect(),
+            note: format!("{} {}(s) on this polygon cover [{}]", self.intervals.len(), self.what, on.join(", ")),
+        }
     }
 }

@@ -20,13 +20,12 @@
 //! through the light parallel to the receiver would project through infinity to the wrong
 //! side; those parts of a caster are clipped away first (w > 0 in the projection).
 
-use super::overlay::{Interval, Overlay, OverlayWalker};
-use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
+use super::overlay::{CoverWalker, Overlay};
+use super::{ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::{clip_polygon, Plane};
 use crate::scene::LightSample;
 use crate::stats::Counters;
-use crate::visibility::Run;
 use glam::{DMat4, DVec3, DVec4};
 
 /// Blinn's projection onto `plane` from a light sample, as a 4×4 matrix on homogeneous
@@ -122,47 +121,11 @@ impl<'a> Planar<'a> {
 
 impl ShadowStage for Planar<'_> {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
-        Box::new(Walker {
-            stage: self,
-            walkers: self.shadows.iter().map(|o| o.walker(0..self.ctx.view.height)).collect(),
-            intervals: Vec::new(),
-        })
+        Box::new(CoverWalker::new(self.ctx, &self.shadows, 0.0, 1.0, "flattened caster"))
     }
 
     fn outlines(&self) -> Vec<Vec<glam::DVec2>> {
         self.shadows.first().map_or_else(Vec::new, |o| o.rings().to_vec())
-    }
-}
-
-struct Walker<'s> {
-    stage: &'s Planar<'s>,
-    walkers: Vec<OverlayWalker<'s>>,
-    intervals: Vec<Interval>,
-}
-
-impl ShadowWalker for Walker<'_> {
-    fn start_line(&mut self, line: u32) {
-        for w in &mut self.walkers {
-            w.advance_to(line);
-        }
-    }
-
-    fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
-        lit.fill(1.0);
-        let k = self.stage.ctx.sample_index(light, sample);
-        self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut self.intervals);
-        for iv in &self.intervals {
-            lit[(iv.start - run.x0) as usize..(iv.end - run.x0) as usize].fill(0.0);
-        }
-    }
-
-    fn decision(&self) -> Decision {
-        let on: Vec<String> =
-            self.intervals.iter().map(|i| format!("#{} covers {}..{}", i.tag, i.start, i.end)).collect();
-        Decision {
-            tested: self.intervals.iter().map(|i| (i.start, i.end, 1)).collect(),
-            note: format!("{} flattened caster(s) on this polygon cover [{}]", self.intervals.len(), on.join(", ")),
-        }
     }
 }
 
