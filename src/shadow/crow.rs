@@ -180,7 +180,8 @@ impl ShadowWalker for Walker<'_> {
         for o in &mut st.open_list {
             o.1 = run.x0;
         }
-        let mut pieces: Vec<(u32, u32, u32)> = Vec::new();
+        let mut pieces = std::mem::take(&mut self.last_pieces);
+        pieces.clear();
         while st.cursor < st.xs.len() && st.xs[st.cursor].0 < run.x1 {
             let (at, t) = st.xs[st.cursor];
             st.toggle(t, at, |t, s, e| pieces.push((t, s, e)));
@@ -191,9 +192,8 @@ impl ShadowWalker for Walker<'_> {
         }
         // Events: where each covering polygon starts and stops counting.
         self.events.clear();
-        self.last_pieces.clone_from(&pieces);
         self.last_counts.clear();
-        for (t, s, e) in pieces {
+        for &(t, s, e) in &pieces {
             if s >= e {
                 continue;
             }
@@ -227,6 +227,7 @@ impl ShadowWalker for Walker<'_> {
             add(s, m, first);
             add(m, e, last);
         }
+        self.last_pieces = pieces;
         // Sweep: the count is constant between events.
         self.events.sort_unstable_by_key(|e| e.0);
         self.runs += 1;

@@ -1,21 +1,27 @@
 //! Polygons that lie on a receiver's surface, in screen space, walked along scanlines with
 //! the shared edge and active-edge tables: Bouknight-Kelley's shadow polygons on the polygon
-//! they fall on, Atherton-Weiler-Greenberg's lit detail polygons on their source polygon.
+//! they fall on, Atherton-Weiler-Greenberg's lit detail polygons on their source polygon,
+//! Blinn's flattened casters on their receiver.
 //!
-//! Each line, the crossings are grouped by receiver; for a visible run on receiver B the
-//! walker gives the pixel intervals where each of B's overlay polygons covers the run.
+//! Each receiver has its own edge table, and its active-edge walk starts on the first line
+//! where a visible run on it asks: for a run on receiver B, the walker gives the pixel
+//! intervals where each of B's overlay polygons covers the run.
 
 use super::{Decision, ShadowContext, ShadowWalker};
 use crate::scan::{boundary, ActiveEdges, EdgeTable};
 use crate::visibility::Run;
 use glam::DVec2;
+use rustc_hash::FxHashMap;
 use std::ops::Range;
 
 /// A set of screen polygons, each lying on a receiver polygon.
 #[derive(Debug, Clone, Default)]
 pub struct Overlay {
-    table: EdgeTable,
-    receiver: Vec<u32>,
+    height: u32,
+    /// One edge table per receiver, in the order receivers first appeared.
+    tables: Vec<EdgeTable>,
+    slot: FxHashMap<u32, u32>,
+    count: usize,
     rings: Vec<Vec<DVec2>>,
     keep_rings: bool,
 }
@@ -35,7 +41,7 @@ impl Overlay {
     /// An empty overlay for an image `height` lines high; `keep_rings` keeps each polygon's
     /// outline for drawing (`--debug`).
     pub fn new(height: u32, keep_rings: bool) -> Self {
-        Overlay { table: EdgeTable::new(height), keep_rings, ..Default::default() }
+        Overlay { height, keep_rings, ..Default::default() }
     }
 
     /// Adds a polygon lying on scene polygon `receiver`; returns its tag.
@@ -45,25 +51,32 @@ impl Overlay {
 
     /// Adds a polygon with several rings (holes, by the even-odd rule) lying on `receiver`.
     pub fn add_rings(&mut self, receiver: u32, rings: &[Vec<DVec2>]) -> u32 {
-        let tag = self.receiver.len() as u32;
+        let tag = self.count as u32;
+        let next = self.tables.len() as u32;
+        let slot = *self.slot.entry(receiver).or_insert(next) as usize;
+        if slot == self.tables.len() {
+            self.tables.push(EdgeTable::new(self.height));
+        }
         for ring in rings {
-            self.table.add_ring(tag, ring);
+            self.tables[slot].add_ring(tag, ring);
             if self.keep_rings {
                 self.rings.push(ring.clone());
             }
         }
-        self.receiver.push(receiver);
+        self.count += 1;
         tag
     }
 
-    /// Sorts the edge table; call once after the last `add`.
+    /// Sorts the edge tables; call once after the last `add`.
     pub fn finish(&mut self) {
-        self.table.finish();
+        for t in &mut self.tables {
+            t.finish();
+        }
     }
 
     /// Number of polygons.
     pub fn len(&self) -> usize {
-        self.receiver.len()
+        self.count
     }
 
     /// The kept outlines (empty unless made with `keep_rings`).
@@ -75,48 +88,48 @@ impl Overlay {
     pub fn walker(&self, lines: Range<u32>) -> OverlayWalker<'_> {
         OverlayWalker {
             overlay: self,
-            aet: ActiveEdges::new(&self.table, lines),
-            grouped: Vec::new(),
+            end: lines.end,
+            line: lines.start,
+            active: (0..self.tables.len()).map(|_| None).collect(),
             open: Vec::new(),
         }
     }
 }
 
-/// Steps an [`Overlay`] down the lines, grouping each line's crossings by receiver.
+/// Steps an [`Overlay`] down the lines; each receiver's active edges start where a run on it
+/// first asks and follow the lines from there.
 pub struct OverlayWalker<'a> {
     overlay: &'a Overlay,
-    aet: ActiveEdges<'a>,
-    /// This line's crossings as (receiver, x, tag), by receiver, then x.
-    grouped: Vec<(u32, f64, u32)>,
+    end: u32,
+    line: u32,
+    active: Vec<Option<ActiveEdges<'a>>>,
     open: Vec<(u32, f64)>,
 }
 
 impl OverlayWalker<'_> {
     /// Moves to `line` (lines must come in increasing order).
     pub fn advance_to(&mut self, line: u32) {
-        let xs = self.aet.advance_to(line);
-        self.grouped.clear();
-        self.grouped.extend(xs.iter().map(|c| (self.overlay.receiver[c.tag as usize], c.x, c.tag)));
-        // By receiver, then x (the crossings' own order).
-        self.grouped.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        self.line = line;
     }
 
     /// Writes into `out` the intervals of the current line where the overlay polygons on
     /// `receiver` cover pixels of `x0..x1` (clipped to it), ordered by where they start.
     pub fn intervals(&mut self, receiver: u32, x0: u32, x1: u32, out: &mut Vec<Interval>) {
         out.clear();
-        let lo = self.grouped.partition_point(|g| g.0 < receiver);
-        let hi = lo + self.grouped[lo..].partition_point(|g| g.0 == receiver);
+        let Some(&slot) = self.overlay.slot.get(&receiver) else { return };
+        let table = &self.overlay.tables[slot as usize];
+        let (line, end) = (self.line, self.end);
+        let aet = self.active[slot as usize].get_or_insert_with(|| ActiveEdges::new(table, line..end));
         self.open.clear();
-        for &(_, x, tag) in &self.grouped[lo..hi] {
-            match self.open.iter().position(|o| o.0 == tag) {
-                None => self.open.push((tag, x)),
+        for c in aet.advance_to(line) {
+            match self.open.iter().position(|o| o.0 == c.tag) {
+                None => self.open.push((c.tag, c.x)),
                 Some(k) => {
                     let (_, xin) = self.open.swap_remove(k);
                     let start = boundary(xin, u32::MAX).max(x0);
-                    let end = boundary(x, u32::MAX).min(x1);
+                    let end = boundary(c.x, u32::MAX).min(x1);
                     if start < end {
-                        out.push(Interval { start, end, tag });
+                        out.push(Interval { start, end, tag: c.tag });
                     }
                 }
             }
