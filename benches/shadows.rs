@@ -95,7 +95,10 @@ fn atherton_weiler_greenberg(c: &mut Criterion) {
 /// Blinn's planar shadows need a receiver: the generated scenes' floor, marked.
 fn planar(c: &mut Criterion) {
     let mut g = group(c, "planar");
-    for (name, mut scene) in [("cubes10", generate::cubes(10, true, W, H).unwrap()), ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap())] {
+    for (name, mut scene) in [
+        ("cubes10", generate::cubes(10, true, W, H).unwrap()),
+        ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap()),
+    ] {
         scene.objects[0].receiver = true;
         let o = opts(ShadowMethod::Planar, ShadowOptions::default());
         g.bench_function(BenchmarkId::new("planar", name), |b| b.iter(|| render(&scene, &o).unwrap()));

@@ -56,11 +56,8 @@ impl ReflectionMethod {
 
 impl std::str::FromStr for ReflectionMethod {
     type Err = crate::Error;
-    fn from_str(s: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| crate::Error::Invalid(format!("unknown reflection method '{s}' (known: off, eye, scene)")))
+    fn from_str(s: &str) -> crate::Result<Self> {
+        crate::error::parse_named(s, &Self::ALL, Self::name, "reflection method")
     }
 }
 

@@ -25,7 +25,7 @@ pub use ray_cast::RayCastShadows;
 pub use stencil_volume::StencilVolume;
 pub use williams::{ShadowFilter, Williams, WilliamsOptions};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::view::View;
@@ -220,12 +220,9 @@ impl ShadowMethod {
 }
 
 impl std::str::FromStr for ShadowMethod {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self> {
-        Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
-            let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
-            Error::Invalid(format!("unknown shadow method '{s}' (known: {})", known.join(", ")))
-        })
+    type Err = crate::Error;
+    fn from_str(s: &str) -> crate::Result<Self> {
+        crate::error::parse_named(s, &Self::ALL, Self::name, "shadow method")
     }
 }
 

@@ -65,10 +65,7 @@ impl Counting {
 impl std::str::FromStr for Counting {
     type Err = crate::Error;
     fn from_str(s: &str) -> crate::Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|c| c.name() == s)
-            .ok_or_else(|| crate::Error::Invalid(format!("unknown count '{s}' (known: zpass, zfail, naive-zpass)")))
+        crate::error::parse_named(s, &Self::ALL, Self::name, "count")
     }
 }
 

@@ -80,10 +80,8 @@ impl Sweep {
 impl std::str::FromStr for Sweep {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        Self::NAMES.iter().find(|n| n.0 == s).map(|n| n.1).ok_or_else(|| {
-            let known: Vec<_> = Self::NAMES.iter().map(|n| n.0).collect();
-            Error::Invalid(format!("unknown sweep '{s}' (known: {})", known.join(", ")))
-        })
+        let all: Vec<Sweep> = Self::NAMES.iter().map(|n| n.1).collect();
+        crate::error::parse_named(s, &all, Sweep::name, "sweep")
     }
 }
 

@@ -10,7 +10,6 @@ pub use ray_cast::RayCastVisibility;
 pub use scanline::{ScanlineVisibility, SpanRecord};
 pub use zbuffer::{rasterize, Depth, DepthBuffer, ZBufferVisibility};
 
-use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::stats::Counters;
 use crate::view::{ScreenPolygon, View};
@@ -80,12 +79,9 @@ impl VisibilityMethod {
 }
 
 impl std::str::FromStr for VisibilityMethod {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self> {
-        Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
-            let known: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
-            Error::Invalid(format!("unknown visibility method '{s}' (known: {})", known.join(", ")))
-        })
+    type Err = crate::Error;
+    fn from_str(s: &str) -> crate::Result<Self> {
+        crate::error::parse_named(s, &Self::ALL, Self::name, "visibility method")
     }
 }
 
