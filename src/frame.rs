@@ -21,6 +21,8 @@ pub struct Frame {
     pub id: Vec<u32>,
     /// `light[k][pixel]`: lit fraction of light `k` at the visible point (0 on background).
     pub light: Vec<Vec<f32>>,
+    /// Samples of each light (the lit fraction of an exact stage is a multiple of 1/n).
+    pub light_samples: Vec<u32>,
     /// Per-pixel counters, when the render was asked for them.
     pub counters: Option<PixelCounters>,
     /// Where a mirror is seen: the face id seen in it (same encoding as `id`); `None` when
@@ -49,6 +51,7 @@ impl Frame {
             color: vec![background; n],
             id: vec![BACKGROUND; n],
             light: vec![vec![0.0; n]; lights],
+            light_samples: vec![1; lights],
             counters: None,
             mirror_id: None,
         }
@@ -81,10 +84,16 @@ impl Frame {
         image::RgbaImage::from_fn(width, height, |x, y| image::Rgba(ids[(y * width + x) as usize].to_le_bytes()))
     }
 
-    /// `light<k>.png`: `round(255 * lit fraction)`.
+    /// `light<k>.png`: `round(255 * lit fraction)`, halves away from zero. A fraction that is
+    /// `m/n` for the light's `n` samples (every exact stage's) is encoded from `m` and `n`,
+    /// so a half is a half however the fraction was summed.
     pub fn light_image(&self, k: usize) -> image::GrayImage {
+        let n = self.light_samples.get(k).copied().unwrap_or(1).max(1) as f64;
         image::GrayImage::from_fn(self.width, self.height, |x, y| {
-            image::Luma([(255.0 * self.light[k][(y * self.width + x) as usize] as f64).round() as u8])
+            let f = self.light[k][(y * self.width + x) as usize] as f64;
+            let m = (f * n).round();
+            let exact = if (f * n - m).abs() < 1e-4 { 255.0 * m / n } else { 255.0 * f };
+            image::Luma([exact.round().clamp(0.0, 255.0) as u8])
         })
     }
 
@@ -172,5 +181,23 @@ impl Frame {
                 self.id[k] == self.id[c] && (!lights || self.light.iter().all(|l| l[k] == l[c]))
             })
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn light_halves_round_away_from_zero_from_the_sample_count() {
+        // 1 of 2 samples: 127.5 -> 128; 1 of 6: 42.5 -> 43; summed in f32 as the pipeline does.
+        let mut f = Frame::new(2, 1, 2, Vec3::ZERO);
+        f.light_samples = vec![2, 6];
+        f.light[0][0] = 0.5;
+        f.light[1][0] = (0..1).map(|_| 1.0f32 / 6.0).sum();
+        f.light[1][1] = (0..3).map(|_| 1.0f32 / 6.0).sum::<f32>();
+        assert_eq!(f.light_image(0).get_pixel(0, 0).0, [128]);
+        assert_eq!(f.light_image(1).get_pixel(0, 0).0, [43]);
+        assert_eq!(f.light_image(1).get_pixel(1, 0).0, [128]);
     }
 }

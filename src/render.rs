@@ -140,6 +140,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     let t = Instant::now();
     let shader = Shader::new(scene, &view, &ctx.samples);
     let mut frame = Frame::new(w, h, scene.lights.len(), scene.render.background);
+    frame.light_samples = ctx.samples.iter().map(|s| s.len() as u32).collect();
     let band = band_height(h);
     let chunk = (band * w) as usize;
     // Each band gets its own rows of every buffer.
