@@ -70,58 +70,67 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod, ShadowOptions)> {
     ]
 }
 
-/// Asserts that `got` sees the same face as `reference` at every pixel whose 3x3
-/// neighbourhood in `reference` has one face id. Returns the number of pixels compared.
-pub fn assert_ids_agree(reference: &Frame, got: &Frame, label: &str) -> usize {
+/// Compares `got` with `reference` at the pixels `interior` picks, collecting `wrong(k)`'s
+/// findings; panics with the first few when there are any. Returns the pixels compared.
+fn assert_agree<T: std::fmt::Debug>(
+    reference: &Frame,
+    label: &str,
+    what: &str,
+    interior: impl Fn(u32, u32) -> bool,
+    wrong: impl Fn(u32, u32, usize) -> Vec<T>,
+) -> usize {
     let mut compared = 0;
     let mut bad = Vec::new();
     for y in 0..reference.height {
         for x in 0..reference.width {
-            if !reference.is_id_interior(x, y) {
-                continue;
-            }
-            compared += 1;
-            let k = (y * reference.width + x) as usize;
-            if reference.id[k] != got.id[k] {
-                bad.push((x, y, reference.id[k], got.id[k]));
+            if interior(x, y) {
+                compared += 1;
+                bad.extend(wrong(x, y, (y * reference.width + x) as usize));
             }
         }
     }
     assert!(
         bad.is_empty(),
-        "{label}: {} of {compared} interior pixels differ in id (x, y, want, got): {:?}",
+        "{label}: {} of {compared} interior pixels differ ({what}): {:?}",
         bad.len(),
         &bad[..bad.len().min(10)]
     );
     compared
 }
 
+/// Asserts that `got` sees the same face as `reference` at every pixel whose 3x3
+/// neighbourhood in `reference` has one face id. Returns the number of pixels compared.
+pub fn assert_ids_agree(reference: &Frame, got: &Frame, label: &str) -> usize {
+    assert_agree(
+        reference,
+        label,
+        "x, y, want, got",
+        |x, y| reference.is_id_interior(x, y),
+        |x, y, k| {
+            if reference.id[k] != got.id[k] {
+                vec![(x, y, reference.id[k], got.id[k])]
+            } else {
+                vec![]
+            }
+        },
+    )
+}
+
 /// Asserts that `got` has the same face id and lit fraction of every light as `reference`
 /// at every pixel whose 3x3 neighbourhood in `reference` is uniform in id and light values.
 pub fn assert_light_agree(reference: &Frame, got: &Frame, label: &str) -> usize {
-    let mut compared = 0;
-    let mut bad = Vec::new();
-    for y in 0..reference.height {
-        for x in 0..reference.width {
-            if !reference.is_interior(x, y) {
-                continue;
-            }
-            compared += 1;
-            let k = (y * reference.width + x) as usize;
-            for (l, (a, b)) in reference.light.iter().zip(&got.light).enumerate() {
-                if reference.id[k] != got.id[k] || a[k] != b[k] {
-                    bad.push((x, y, l, a[k], b[k]));
-                }
-            }
-        }
-    }
-    assert!(
-        bad.is_empty(),
-        "{label}: {} of {compared} interior pixels differ (x, y, light, want, got): {:?}",
-        bad.len(),
-        &bad[..bad.len().min(10)]
-    );
-    compared
+    assert_agree(
+        reference,
+        label,
+        "x, y, light, want, got",
+        |x, y| reference.is_interior(x, y),
+        |x, y, k| {
+            (0..reference.light.len())
+                .filter(|&l| reference.id[k] != got.id[k] || reference.light[l][k] != got.light[l][k])
+                .map(|l| (x, y, l, reference.light[l][k], got.light[l][k]))
+                .collect()
+        },
+    )
 }
 
 /// Interior pixels of `reference` (as in [`assert_light_agree`]) where some light is not
