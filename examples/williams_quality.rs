@@ -28,7 +28,7 @@ fn main() {
                 [("0", Some(0.0), 0.0), ("default", None, 1.5), ("1% of scene", Some(0.01 * extent), 1.5)]
             {
                 for filter in [ShadowFilter::Nearest, ShadowFilter::Pcf(3)] {
-                    let williams = WilliamsOptions { map_size, bias, slope_bias: slope, filter, cull_front: false };
+                    let williams = WilliamsOptions { map_size, bias, slope_bias: slope, filter, ..Default::default() };
                     let opts = RenderOptions {
                         shadows: ShadowMethod::Williams,
                         shadow_options: ShadowOptions { williams, ..Default::default() },

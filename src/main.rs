@@ -95,6 +95,7 @@ impl ShadowArgs {
                 slope_bias: self.slope_bias,
                 filter,
                 cull_front: self.cull_front,
+                ..WilliamsOptions::default()
             },
             awg_database: None,
             keep_outlines,

@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use std::path::Path;
 use umbra::shadow::{ShadowFilter, ShadowOptions, WilliamsOptions};
-use umbra::{Frame, Scene, ShadowMethod, VisibilityMethod};
+use umbra::{Frame, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 fn floor_and_box(receiver: bool, light: &str) -> Scene {
     let src = format!(
@@ -90,7 +90,7 @@ fn shadow_map_without_bias_shows_acne() {
             bias: Some(0.0),
             slope_bias: 0.0,
             filter: ShadowFilter::Nearest,
-            cull_front: false,
+            ..WilliamsOptions::default()
         },
         ..ShadowOptions::default()
     };
@@ -126,4 +126,21 @@ fn seed_gaussian_weights() {
     assert_eq!(offsets, vec![0, 1, -1, 3, -3, 5, -5, 7, -7, 9, -9, 11, -11, 13, -13]);
     let sum: f32 = taps.iter().map(|t| t.1).sum();
     assert!((sum - 1.0665).abs() < 1e-3, "{sum}");
+}
+
+/// Maps drawn in memory kept from an earlier render (with a nearer light, whose map holds
+/// larger nearness everywhere) come out as if drawn in fresh memory.
+#[test]
+fn reused_map_storage_leaves_nothing_behind() {
+    let options = RenderOptions { shadows: ShadowMethod::Williams, ..RenderOptions::default() };
+    let first = floor_and_box(false, "[[light]]\nkind = \"point\"\nposition = [1.5, 4.5, 1.0]\n");
+    let second = floor_and_box(false, POINT);
+    umbra::render(&first, &options).unwrap();
+    assert!(options.shadow_options.williams.map_storage.bytes() >= 2048 * 2048 * 4);
+    let reused = umbra::render(&second, &options).unwrap().frame;
+    let fresh = umbra::render(&second, &RenderOptions { shadows: ShadowMethod::Williams, ..RenderOptions::default() })
+        .unwrap()
+        .frame;
+    assert_eq!(reused.light[0], fresh.light[0]);
+    assert_eq!(reused.color, fresh.color);
 }

@@ -23,7 +23,7 @@ pub use crow::Crow;
 pub use planar::Planar;
 pub use ray_cast::RayCastShadows;
 pub use stencil_volume::StencilVolume;
-pub use williams::{ShadowFilter, Williams, WilliamsOptions};
+pub use williams::{MapStorage, ShadowFilter, Williams, WilliamsOptions};
 
 use crate::error::Result;
 use crate::scene::{LightSample, Scene};

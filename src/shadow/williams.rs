@@ -25,6 +25,7 @@ use crate::view::{DepthPlane, ScreenPolygon, View};
 use crate::visibility::{rasterize, Run};
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
+use std::sync::{Arc, Mutex};
 
 /// How the shadow-map comparison is filtered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -50,11 +51,60 @@ pub struct WilliamsOptions {
     pub filter: ShadowFilter,
     /// Leave out polygons facing the light in pass 1 (seed 003).
     pub cull_front: bool,
+    /// Memory for the maps, shared by clones of these options and kept between renders.
+    pub map_storage: MapStorage,
 }
 
 impl Default for WilliamsOptions {
     fn default() -> Self {
-        WilliamsOptions { map_size: 2048, bias: None, slope_bias: 1.5, filter: ShadowFilter::Pcf(3), cull_front: false }
+        WilliamsOptions {
+            map_size: 2048,
+            bias: None,
+            slope_bias: 1.5,
+            filter: ShadowFilter::Pcf(3),
+            cull_front: false,
+            map_storage: MapStorage::default(),
+        }
+    }
+}
+
+/// The memory of the depth maps, kept between renders: frames rendered with the same
+/// options (or clones of them) reuse it, as a real-time renderer keeps its shadow-map
+/// textures, instead of having the system hand out and zero fresh pages for every map of
+/// every frame (which, on the benchmark machine, costs more than drawing the map). It holds
+/// as many maps as the largest render used; a new `MapStorage` starts empty. Not an
+/// option: any two compare equal.
+#[derive(Clone, Default)]
+pub struct MapStorage(Arc<Mutex<Vec<Vec<f32>>>>);
+
+impl MapStorage {
+    /// A buffer to draw a map in (empty if none is kept).
+    fn take(&self) -> Vec<f32> {
+        self.0.lock().map(|mut kept| kept.pop().unwrap_or_default()).unwrap_or_default()
+    }
+
+    /// Keeps a map's buffer for the next render.
+    fn give(&self, buffer: Vec<f32>) {
+        if let Ok(mut kept) = self.0.lock() {
+            kept.push(buffer);
+        }
+    }
+
+    /// Bytes kept.
+    pub fn bytes(&self) -> usize {
+        self.0.lock().map_or(0, |kept| kept.iter().map(|b| b.capacity() * 4).sum())
+    }
+}
+
+impl PartialEq for MapStorage {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for MapStorage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "MapStorage({} bytes kept)", self.bytes())
     }
 }
 
@@ -70,46 +120,59 @@ enum Projection {
 }
 
 impl Projection {
-    /// Texel coordinates and depth of the point `h.xyz / h.w` (homogeneous, `w > 0`), or
-    /// `None` behind a perspective map.
-    #[inline]
-    fn locate(&self, h: DVec4) -> Option<(f64, f64, f64)> {
+    /// The rows taking a homogeneous world point `h = (w·p, w)` (`w > 0`) to `(X, Y, Z)`:
+    /// texel coordinates `(X, Y) / q` with `q = Z` for a perspective map and `q = w` for an
+    /// orthographic one, and depth `Z / w`. Along a run `h` is linear in x, so these are too.
+    fn rows(&self) -> [DVec4; 3] {
         match self {
             Projection::Perspective(view) => {
-                let v = h.truncate() - view.eye * h.w;
-                let c = DVec3::new(v.dot(view.r), v.dot(view.u), v.dot(view.f));
-                (c.z > 0.0).then(|| {
-                    let s = view.project(c);
-                    (s.x, s.y, c.z / h.w)
-                })
+                // Camera-space rows, then View::project with the division by depth left out.
+                let row = |a: DVec3| a.extend(-a.dot(view.eye));
+                let (r, u, f) = (row(view.r), row(view.u), row(view.f));
+                let (half_w, half_h) = (0.5 * view.width as f64, 0.5 * view.height as f64);
+                [r * (half_w / (view.t * view.aspect)) + f * half_w, f * half_h - u * (half_h / view.t), f]
             }
             Projection::Ortho { u, v, d, u0, v0, s0, texel } => {
-                let (p, w) = (h.truncate(), h.w);
-                Some(((p.dot(*u) - u0 * w) / (texel * w), (v0 * w - p.dot(*v)) / (texel * w), (p.dot(*d) - s0 * w) / w))
+                [(*u).extend(-u0) / *texel, (-*v).extend(*v0) / *texel, (*d).extend(-s0)]
             }
         }
     }
 
-    /// World size of a texel at depth `z`.
-    fn texel_size(&self, z: f64) -> f64 {
+    /// World size of a texel at depth `z`, as `(constant, per unit depth)`.
+    fn texel_size(&self) -> (f64, f64) {
         match self {
-            Projection::Perspective(view) => 2.0 * z * view.t / view.height as f64,
-            Projection::Ortho { texel, .. } => *texel,
+            Projection::Perspective(view) => (0.0, 2.0 * view.t / view.height as f64),
+            Projection::Ortho { texel, .. } => (*texel, 0.0),
         }
     }
 }
+
+/// Texels added to each row of a map: rows a power of two apart would otherwise share
+/// cache sets, and a kernel walking down the map would evict its own rows. The extra
+/// columns hold what lies just beyond the map's edge, and are never read.
+const PAD: u32 = 16;
 
 /// One depth map: the nearness of the nearest caster per texel (as rasterised: `1/z` for a
 /// perspective map, `−depth` for an orthographic one; `−∞` where none was drawn).
 struct DepthMap {
     proj: Projection,
+    rows: [DVec4; 3],
     size: u32,
     nearness: Vec<f32>,
+    /// Where the texels' memory goes back to.
+    storage: MapStorage,
+}
+
+impl Drop for DepthMap {
+    fn drop(&mut self) {
+        self.storage.give(std::mem::take(&mut self.nearness));
+    }
 }
 
 impl DepthMap {
     /// Pass 1 for one projection.
-    fn render(ctx: &ShadowContext, proj: Projection, size: u32, sample: LightSample, cull_front: bool) -> DepthMap {
+    fn render(ctx: &ShadowContext, proj: Projection, sample: LightSample, o: &WilliamsOptions) -> DepthMap {
+        let size = o.map_size;
         let scene = ctx.scene;
         let casters = (0..scene.polygons.len()).filter(|&i| {
             let plane = &scene.polygons[i].plane;
@@ -117,7 +180,7 @@ impl DepthMap {
                 LightSample::Point(s) => plane.distance(s) > 0.0,
                 LightSample::Directional(d) => plane.n.dot(d) < 0.0,
             };
-            scene.casts_shadows(i) && !(cull_front && facing)
+            scene.casts_shadows(i) && !(o.cull_front && facing)
         });
         let screen: Vec<ScreenPolygon> = match &proj {
             Projection::Perspective(view) => {
@@ -157,52 +220,124 @@ impl DepthMap {
                 })
                 .collect(),
         };
-        let nearness = rasterize::<f32>(&screen, size, size, false).depth;
-        DepthMap { proj, size, nearness }
+        let storage = o.map_storage.clone();
+        let nearness = rasterize::<f32>(&screen, size + PAD, size, false, storage.take()).depth;
+        DepthMap { rows: proj.rows(), proj, size, nearness, storage }
     }
 
-    /// The nearness above which a texel hides a point at depth `z`: `Z_map + bias < z` means
-    /// shadow, that is `1/Z_map > 1/(z − bias)` (perspective) or `−Z_map > bias − z` (ortho).
-    fn threshold(&self, z: f64, bias: f64) -> f32 {
-        match self.proj {
-            Projection::Perspective(_) if z - bias <= 0.0 => f32::INFINITY,
-            Projection::Perspective(_) => (1.0 / (z - bias)) as f32,
-            Projection::Ortho { .. } => (bias - z) as f32,
+    /// Pass 2 along a run: the lit value at each point `h0 + i·step` (homogeneous, `w > 0`)
+    /// under a `(2r+1)²` kernel, with bias `b0 + b1 × depth` where `(b0, b1)` is `constant`
+    /// plus `slope` texels. The run is taken in batches: first each point is located in
+    /// the map (straight-line arithmetic, two divisions), then its kernel is compared.
+    fn lit_run(&self, h0: DVec4, step: DVec4, constant: f64, slope: f64, r: usize, out: &mut [f32]) {
+        const BATCH: usize = 64;
+        let [rx, ry, rz] = self.rows;
+        let at = |h: DVec4| DVec4::new(rx.dot(h), ry.dot(h), rz.dot(h), h.w);
+        let (l0, dl) = (at(h0), at(step));
+        let (t0, t1) = self.proj.texel_size();
+        let (b0, b1) = (constant + slope * t0, slope * t1);
+        let mut located = [Located::default(); BATCH];
+        for (b, out) in out.chunks_mut(BATCH).enumerate() {
+            let located = &mut located[..out.len()];
+            let first = (b * BATCH) as f64;
+            for (i, p) in located.iter_mut().enumerate() {
+                let l = l0 + dl * (first + i as f64);
+                *p = match self.proj {
+                    // `Z_map + bias < z` means shadow, that is `1/Z_map > 1/(z − bias)`.
+                    Projection::Perspective(_) => {
+                        let q = 1.0 / l.z;
+                        let denom = l.z * (1.0 - b1) - b0 * l.w;
+                        let threshold = if denom > 0.0 { l.w / denom } else { f64::INFINITY };
+                        if l.z > 0.0 {
+                            Located::new(l.x * q, l.y * q, threshold)
+                        } else {
+                            Located::BEHIND
+                        }
+                    }
+                    // The map holds `−Z_map`: shadow when `−Z_map > bias − z`.
+                    Projection::Ortho { .. } => {
+                        let q = 1.0 / l.w;
+                        Located::new(l.x * q, l.y * q, b0 - l.z * q)
+                    }
+                };
+            }
+            self.filter(located, r, out);
         }
     }
 
-    /// The fraction of the `k×k` texels around `(x, y)` that do not hide depth `z`: compare
-    /// each texel first, then average (1 outside the map: nothing was recorded there).
-    fn lit(&self, x: f64, y: f64, z: f64, bias: f64, k: u32) -> f32 {
-        // floor, with anything left of or above the map at −1.
-        let cell = |v: f64| if v < 0.0 { -1 } else { v as i64 };
-        let (i, j) = (cell(x), cell(y));
-        let r = (k / 2) as i64;
-        let n = self.size as i64;
-        let threshold = self.threshold(z, bias);
-        let mut lit = 0u32;
-        if i >= r && j >= r && i + r < n && j + r < n {
-            // The whole kernel lies inside the map.
-            for tj in j - r..=j + r {
-                let row = &self.nearness[(tj * n + i - r) as usize..=(tj * n + i + r) as usize];
-                lit += row.iter().filter(|&&d| d <= threshold).count() as u32;
-            }
-        } else {
-            for tj in j - r..=j + r {
-                for ti in i - r..=i + r {
-                    let inside = ti >= 0 && tj >= 0 && ti < n && tj < n;
-                    lit += (!inside || self.nearness[(tj * n + ti) as usize] <= threshold) as u32;
+    /// Compares each texel of the `(2r+1)²` kernel around each located point with the
+    /// point's threshold, then averages the answers — never the depths. Texels outside the
+    /// map count as lit: nothing was recorded there.
+    fn filter(&self, located: &[Located], r: usize, out: &mut [f32]) {
+        // The common radii get loops of their own, unrolled.
+        match r {
+            0 => self.filter_with(located, 0, out),
+            1 => self.filter_with(located, 1, out),
+            _ => self.filter_with(located, r, out),
+        }
+    }
+
+    #[inline(always)]
+    fn filter_with(&self, located: &[Located], r: usize, out: &mut [f32]) {
+        let (n, stride) = (self.size as usize, (self.size + PAD) as usize);
+        let width = 2 * r + 1;
+        let share = 1.0 / (width * width) as f32;
+        let (lo, hi) = (r as f32, (n - r) as f32);
+        for (p, o) in located.iter().zip(out) {
+            let lit = if p.x >= lo && p.y >= lo && p.x < hi && p.y < hi {
+                // The whole kernel lies inside the map.
+                let corner = (p.y as usize - r) * stride + p.x as usize - r;
+                let block = &self.nearness[corner..corner + (width - 1) * stride + width];
+                let mut lit = 0;
+                for row in 0..width {
+                    for texel in &block[row * stride..row * stride + width] {
+                        lit += u32::from(*texel <= p.threshold);
+                    }
                 }
-            }
+                lit
+            } else {
+                // Texel cells, with points far outside kept far enough that their kernel
+                // misses the map.
+                let cell = |v: f32| v.clamp(-(width as f32), (n + width) as f32).floor() as i64;
+                let (cx, cy, r) = (cell(p.x), cell(p.y), r as i64);
+                let mut lit = 0;
+                for ty in cy - r..=cy + r {
+                    for tx in cx - r..=cx + r {
+                        let inside = (0..n as i64).contains(&tx) && (0..n as i64).contains(&ty);
+                        lit += u32::from(!inside || self.nearness[ty as usize * stride + tx as usize] <= p.threshold);
+                    }
+                }
+                lit
+            };
+            *o = lit as f32 * share;
         }
-        lit as f32 / (k * k) as f32
+    }
+}
+
+/// A point located in a shadow map: texel coordinates, and the nearness above which a
+/// texel hides it.
+#[derive(Debug, Clone, Copy, Default)]
+struct Located {
+    x: f32,
+    y: f32,
+    threshold: f32,
+}
+
+impl Located {
+    /// Behind a perspective map's light: far outside the map, so lit.
+    const BEHIND: Located = Located { x: f32::NEG_INFINITY, y: f32::NEG_INFINITY, threshold: f32::INFINITY };
+
+    #[inline]
+    fn new(x: f64, y: f64, threshold: f64) -> Self {
+        Located { x: x as f32, y: y as f32, threshold: threshold as f32 }
     }
 }
 
 /// A light sample's maps: one, or a cube of six.
 enum LightMaps {
-    Single(DepthMap),
-    Cube(Box<[DepthMap; 6]>),
+    Single(Box<DepthMap>),
+    /// The six faces of [`CUBE`] around the light at the point.
+    Cube(Box<[DepthMap; 6]>, DVec3),
 }
 
 /// The cube faces' axes and up vectors.
@@ -242,10 +377,21 @@ impl LightMaps {
             };
             Projection::Perspective(View::new(&cam))
         };
+        // The map's rows are turned to run along the screen's rows (the eye's right vector
+        // seen from the light), so that pass 2, walking a screen row, walks along map rows
+        // and reads texels that share cache lines.
+        let across = |axis: DVec3| {
+            let r = ctx.view.r - axis * axis.dot(ctx.view.r);
+            if r.length() < 1e-6 {
+                axis.any_orthonormal_vector()
+            } else {
+                r.normalize()
+            }
+        };
         match sample {
             LightSample::Directional(d) => {
                 counters.add("maps_ortho", 1);
-                let u = d.any_orthonormal_vector();
+                let u = across(d);
                 let v = d.cross(u);
                 let range = |a: DVec3| {
                     corners
@@ -263,7 +409,7 @@ impl LightMaps {
                     s0: s0 - 0.01 * side,
                     texel: side / o.map_size as f64,
                 };
-                LightMaps::Single(DepthMap::render(ctx, proj, o.map_size, sample, o.cull_front))
+                LightMaps::Single(Box::new(DepthMap::render(ctx, proj, sample, o)))
             }
             LightSample::Point(s) => {
                 let center = (lo + hi) * 0.5;
@@ -274,48 +420,50 @@ impl LightMaps {
                     .fold(0.0, f64::max);
                 if half < 80f64.to_radians() {
                     counters.add("maps_perspective", 1);
-                    let proj = pinhole(s, axis, DVec3::Y, (2.0 * half).to_degrees() * 1.02 + 0.1);
-                    LightMaps::Single(DepthMap::render(ctx, proj, o.map_size, sample, o.cull_front))
+                    let proj = pinhole(s, axis, across(axis).cross(axis), (2.0 * half).to_degrees() * 1.02 + 0.1);
+                    LightMaps::Single(Box::new(DepthMap::render(ctx, proj, sample, o)))
                 } else {
                     counters.add("maps_cube_faces", 6);
-                    let faces = CUBE.map(|(axis, up)| {
-                        DepthMap::render(ctx, pinhole(s, axis, up, 90.0), o.map_size, sample, o.cull_front)
-                    });
-                    LightMaps::Cube(Box::new(faces))
+                    let faces = CUBE.map(|(axis, up)| DepthMap::render(ctx, pinhole(s, axis, up, 90.0), sample, o));
+                    LightMaps::Cube(Box::new(faces), s)
                 }
             }
         }
     }
 
-    /// The map that holds `p`.
-    fn map_for(&self, p: DVec3, sample: LightSample) -> &DepthMap {
+    /// Pass 2 along a run (see [`DepthMap::lit_run`]); a cube's run is cut where the face
+    /// holding its points changes.
+    fn lit_run(&self, h0: DVec4, step: DVec4, constant: f64, slope: f64, r: usize, out: &mut [f32]) {
         match self {
-            LightMaps::Single(m) => m,
-            LightMaps::Cube(faces) => {
-                let LightSample::Point(s) = sample else { return &faces[0] };
-                let v = p - s;
-                let a = v.abs();
-                let k = if a.x >= a.y && a.x >= a.z {
-                    if v.x >= 0.0 {
-                        0
-                    } else {
-                        1
-                    }
-                } else if a.y >= a.z {
-                    if v.y >= 0.0 {
-                        2
-                    } else {
-                        3
-                    }
-                } else if v.z >= 0.0 {
-                    4
-                } else {
-                    5
+            LightMaps::Single(map) => map.lit_run(h0, step, constant, slope, r, out),
+            LightMaps::Cube(faces, s) => {
+                let face = |i: usize| {
+                    let h = h0 + step * i as f64;
+                    cube_face(h.truncate() / h.w - *s)
                 };
-                &faces[k]
+                let mut a = 0;
+                while a < out.len() {
+                    let f = face(a);
+                    let b = (a + 1..out.len()).find(|&i| face(i) != f).unwrap_or(out.len());
+                    faces[f].lit_run(h0 + step * a as f64, step, constant, slope, r, &mut out[a..b]);
+                    a = b;
+                }
             }
         }
     }
+}
+
+/// The cube face (index into [`CUBE`]) whose axis is nearest direction `v`.
+fn cube_face(v: DVec3) -> usize {
+    let a = v.abs();
+    let (axis, positive) = if a.x >= a.y && a.x >= a.z {
+        (0, v.x >= 0.0)
+    } else if a.y >= a.z {
+        (1, v.y >= 0.0)
+    } else {
+        (2, v.z >= 0.0)
+    };
+    2 * axis + usize::from(!positive)
 }
 
 /// The prepared stage.
@@ -345,10 +493,11 @@ impl<'a> Williams<'a> {
     }
 
     /// Pass 2 for the pixels of `run` on line `line` (written to `out`): the
-    /// filtered lit value of flat sample `k`. The visible point, in homogeneous form
-    /// `(eye·D − dist·ray, D)` with `D = n·ray`, is linear in x along the line, so it is
-    /// stepped rather than recomputed. The slope-scaled bias takes the polygon's angle to
-    /// the light at its centroid, once per polygon, as `glPolygonOffset` does.
+    /// filtered lit value of flat sample `k` under a `size × size` kernel. The visible
+    /// point, in homogeneous form `(eye·D − dist·ray, D)` with `D = n·ray`, is linear in x
+    /// along the line, so it is stepped rather than recomputed. The slope-scaled bias takes
+    /// the polygon's angle to the light at its centroid, once per polygon, as
+    /// `glPolygonOffset` does.
     fn lookup_run(&self, k: usize, sample: LightSample, line: u32, run: &Run, size: u32, out: &mut [f32]) {
         let (poly, x0) = (run.poly as usize, run.x0);
         let view = self.ctx.view;
@@ -359,30 +508,18 @@ impl<'a> Williams<'a> {
             let d = plane.n.dot(ray);
             (view.eye * d - ray * plane.distance(view.eye)).extend(d)
         };
-        let mut h = point_h(x0 as f64 + 0.5);
-        let step = point_h(x0 as f64 + 1.5) - h;
+        let h0 = point_h(x0 as f64 + 0.5);
+        let step = point_h(x0 as f64 + 1.5) - h0;
         // Keep w > 0 so the maps' divisions read the right way round.
-        let flip = if h.w < 0.0 { -1.0 } else { 1.0 };
-        let (h0, step) = (h * flip, step * flip);
-        h = h0;
+        let flip = if h0.w < 0.0 { -1.0 } else { 1.0 };
         let c = crate::geometry::centroid(self.ctx.scene.verts(poly));
         let (l, _) = sample.toward(c);
         let cos = plane.n.dot(l).abs().max(1e-3);
         let tan = ((1.0 - cos * cos).sqrt() / cos).min(10.0);
-        for o in out.iter_mut() {
-            let p = h.truncate() / h.w;
-            let map = self.maps[k].map_for(p, sample);
-            *o = match map.proj.locate(h) {
-                Some((x, y, z)) => {
-                    // A wider kernel reaches texels farther along the slope.
-                    let reach = (size / 2 + 1) as f64;
-                    let bias = self.bias + self.options.slope_bias * reach * map.proj.texel_size(z) * tan;
-                    map.lit(x, y, z, bias, size)
-                }
-                None => 1.0,
-            };
-            h += step;
-        }
+        // A wider kernel reaches texels farther along the slope.
+        let r = (size / 2) as usize;
+        let slope = self.options.slope_bias * (r + 1) as f64 * tan;
+        self.maps[k].lit_run(h0 * flip, step * flip, self.bias, slope, r, out);
     }
 
     /// Seed 002: the N×N PCF term of every visible pixel in a screen-sized buffer (1 where

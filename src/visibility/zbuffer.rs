@@ -20,7 +20,7 @@ pub struct ZBufferVisibility {
 impl ZBufferVisibility {
     /// Rasterises every screen polygon into the buffers.
     pub fn new(screen: &[ScreenPolygon], view: &View, counters: &mut Counters) -> Self {
-        let buffers = rasterize::<f64>(screen, view.width, view.height, true);
+        let buffers = rasterize::<f64>(screen, view.width, view.height, true, Vec::new());
         counters.add("depth_tests", buffers.tests);
         counters.add("depth_writes", buffers.writes);
         counters.add("buffer_bytes", (buffers.ids.len() * 4 + buffers.depth.len() * 8) as u64);
@@ -32,12 +32,15 @@ impl ZBufferVisibility {
 pub trait Depth: Copy + PartialOrd + Send + Sync {
     /// Nothing drawn (farther than anything).
     const FAR: Self;
+    /// Zero, which a fresh buffer can be allocated as without being written.
+    const ZERO: Self;
     /// From a depth-plane value.
     fn from_f64(v: f64) -> Self;
 }
 
 impl Depth for f64 {
     const FAR: Self = f64::NEG_INFINITY;
+    const ZERO: Self = 0.0;
     fn from_f64(v: f64) -> Self {
         v
     }
@@ -45,6 +48,7 @@ impl Depth for f64 {
 
 impl Depth for f32 {
     const FAR: Self = f32::NEG_INFINITY;
+    const ZERO: Self = 0.0;
     fn from_f64(v: f64) -> Self {
         v as f32
     }
@@ -70,7 +74,17 @@ pub struct DepthBuffer<D> {
 /// centre the polygon whose depth plane is largest (nearest), in parallel bands of lines.
 /// Used for visibility (with ids, in f64) and, from the light, for Williams' shadow maps
 /// (depth only, in f32).
-pub fn rasterize<D: Depth>(screen: &[ScreenPolygon], width: u32, height: u32, with_ids: bool) -> DepthBuffer<D> {
+///
+/// The depth buffer is built in `storage` (any contents; reallocated if too small), so a
+/// caller drawing many frames can hand back the last frame's buffer instead of having fresh
+/// pages zeroed by the system each time.
+pub fn rasterize<D: Depth>(
+    screen: &[ScreenPolygon],
+    width: u32,
+    height: u32,
+    with_ids: bool,
+    storage: Vec<D>,
+) -> DepthBuffer<D> {
     let (w, h) = (width as usize, height);
     let spans: Vec<Range<u32>> = screen
         .iter()
@@ -82,8 +96,11 @@ pub fn rasterize<D: Depth>(screen: &[ScreenPolygon], width: u32, height: u32, wi
             first..end
         })
         .collect();
-    let mut ids = if with_ids { vec![u32::MAX; w * h as usize] } else { Vec::new() };
-    let mut depth = vec![D::FAR; w * h as usize];
+    // Zeroed allocations cost nothing until written: each band clears its own rows, in
+    // parallel and just before drawing them.
+    let mut ids = if with_ids { vec![0u32; w * h as usize] } else { Vec::new() };
+    let mut depth = if storage.capacity() >= w * h as usize { storage } else { vec![D::ZERO; w * h as usize] };
+    depth.resize(w * h as usize, D::ZERO);
     let band = crate::render::band_height(h);
     let chunk = w * band as usize;
     let mut id_chunks: Vec<&mut [u32]> = ids.chunks_mut(chunk).collect();
@@ -95,6 +112,8 @@ pub fn rasterize<D: Depth>(screen: &[ScreenPolygon], width: u32, height: u32, wi
         .map(|(bi, (depth, ids))| {
             let y0 = bi as u32 * band;
             let lines = y0..(y0 + band).min(h);
+            depth.fill(D::FAR);
+            ids.fill(u32::MAX);
             let mut table = EdgeTable::new(h);
             let (mut tests, mut writes) = (0u64, 0u64);
             for (p, r) in screen.iter().zip(&spans) {
@@ -102,15 +121,24 @@ pub fn rasterize<D: Depth>(screen: &[ScreenPolygon], width: u32, height: u32, wi
                     continue;
                 }
                 for_each_span(&mut table, &[&p.ring], width, h, lines.clone(), |y, x0, x1| {
-                    let yc = y as f64 + 0.5;
-                    let row = (y - y0) as usize * w;
+                    let z0 = p.depth.inv_z(x0 as f64 + 0.5, y as f64 + 0.5);
+                    let (a, b) = ((y - y0) as usize * w + x0 as usize, (y - y0) as usize * w + x1 as usize);
                     tests += (x1 - x0) as u64;
-                    for x in x0..x1 {
-                        let z = D::from_f64(p.depth.inv_z(x as f64 + 0.5, yc));
-                        let k = row + x as usize;
-                        if z > depth[k] {
-                            depth[k] = z;
-                            if let Some(id) = ids.get_mut(k) {
+                    if ids.is_empty() {
+                        // Depth only (a shadow map): branch-free, so it vectorises.
+                        for (i, d) in depth[a..b].iter_mut().enumerate() {
+                            let z = D::from_f64(z0 + p.depth.a * i as f64);
+                            let nearer = z > *d;
+                            writes += u64::from(nearer);
+                            *d = if nearer { z } else { *d };
+                        }
+                        return;
+                    }
+                    for (i, d) in depth[a..b].iter_mut().enumerate() {
+                        let z = D::from_f64(z0 + p.depth.a * i as f64);
+                        if z > *d {
+                            *d = z;
+                            if let Some(id) = ids.get_mut(a + i) {
                                 *id = p.poly;
                             }
                             writes += 1;
