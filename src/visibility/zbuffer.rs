@@ -124,26 +124,27 @@ pub fn rasterize<D: Depth>(
                     let z0 = p.depth.inv_z(x0 as f64 + 0.5, y as f64 + 0.5);
                     let (a, b) = ((y - y0) as usize * w + x0 as usize, (y - y0) as usize * w + x1 as usize);
                     tests += (x1 - x0) as u64;
+                    // Counted locally: a counter outside the closure would be read and
+                    // written through memory at every pixel.
+                    let mut span_writes = 0;
                     if ids.is_empty() {
                         // Depth only (a shadow map): branch-free, so it vectorises.
                         for (i, d) in depth[a..b].iter_mut().enumerate() {
                             let z = D::from_f64(z0 + p.depth.a * i as f64);
                             let nearer = z > *d;
-                            writes += u64::from(nearer);
+                            span_writes += u32::from(nearer);
                             *d = if nearer { z } else { *d };
                         }
-                        return;
-                    }
-                    for (i, d) in depth[a..b].iter_mut().enumerate() {
-                        let z = D::from_f64(z0 + p.depth.a * i as f64);
-                        if z > *d {
-                            *d = z;
-                            if let Some(id) = ids.get_mut(a + i) {
-                                *id = p.poly;
+                    } else {
+                        for ((d, id), i) in depth[a..b].iter_mut().zip(&mut ids[a..b]).zip(0..) {
+                            let z = D::from_f64(z0 + p.depth.a * i as f64);
+                            if z > *d {
+                                (*d, *id) = (z, p.poly);
+                                span_writes += 1;
                             }
-                            writes += 1;
                         }
                     }
+                    writes += u64::from(span_writes);
                 });
             }
             (tests, writes)
