@@ -6,7 +6,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use std::sync::Arc;
 use std::time::Duration;
-use umbra::shadow::{ShadowDatabase, ShadowOptions};
+use umbra::shadow::{ShadowDatabase, ShadowFilter, ShadowOptions, WilliamsOptions};
 use umbra::{generate, render, Counters, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 const W: u32 = 1920;
@@ -106,5 +106,29 @@ fn planar(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, stages, atherton_weiler_greenberg, planar);
+/// Williams' method on its own ground: behind z-buffer visibility, against the same render
+/// without shadows; and with the nearest-texel filter of the 1978 paper.
+fn williams(c: &mut Criterion) {
+    let mut g = group(c, "williams");
+    for (name, scene) in [
+        ("cubes10", generate::cubes(10, true, W, H).unwrap()),
+        ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap()),
+    ] {
+        let nearest = ShadowOptions {
+            williams: WilliamsOptions { filter: ShadowFilter::Nearest, ..Default::default() },
+            ..Default::default()
+        };
+        for (label, visibility, m, o) in [
+            ("zbuffer-none", VisibilityMethod::ZBuffer, ShadowMethod::None, ShadowOptions::default()),
+            ("zbuffer-williams-2048", VisibilityMethod::ZBuffer, ShadowMethod::Williams, ShadowOptions::default()),
+            ("scanline-williams-2048-nearest", VisibilityMethod::Scanline, ShadowMethod::Williams, nearest),
+        ] {
+            let o = RenderOptions { visibility, ..opts(m, o) };
+            g.bench_with_input(BenchmarkId::new(label, name), &scene, |b, s| b.iter(|| render(s, &o).unwrap()));
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, stages, atherton_weiler_greenberg, planar, williams);
 criterion_main!(benches);
