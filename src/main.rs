@@ -77,9 +77,6 @@ struct ShadowArgs {
 
 impl ShadowArgs {
     fn options(&self, keep_outlines: bool) -> umbra::Result<ShadowOptions> {
-        if self.map_size == 0 || self.map_size > 16384 || self.pcf_size % 2 == 0 {
-            return Err(Error::Invalid("--map-size must be 1..=16384 and --pcf-size odd".into()));
-        }
         let filter = match self.shadow_filter {
             FilterArg::Nearest => ShadowFilter::Nearest,
             FilterArg::Pcf => ShadowFilter::Pcf(self.pcf_size),

@@ -100,6 +100,9 @@ fn depth_complexity(screen: &[crate::view::ScreenPolygon], w: u32, h: u32) -> Ve
 /// Renders `scene` with the chosen stages.
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     let start = Instant::now();
+    if opts.shadows == ShadowMethod::Williams {
+        opts.shadow_options.williams.check()?;
+    }
     let mut stats = Stats {
         visibility: opts.visibility.name().into(),
         shadows: opts.shadows.name().into(),

@@ -112,6 +112,12 @@ impl View {
         self.f + sx * self.r + sy * self.u
     }
 
+    /// How [`View::ray`] changes from one pixel to the next along a line.
+    #[inline]
+    pub fn ray_step(&self) -> DVec3 {
+        self.r * (2.0 * self.t * self.aspect / self.width as f64)
+    }
+
     /// The world point on `plane` seen at screen position `(x, y)`.
     #[inline]
     pub fn point_on(&self, plane: &Plane, x: f64, y: f64) -> DVec3 {

@@ -119,6 +119,25 @@ fn planar_shadows_need_a_receiver() {
 }
 
 #[test]
+fn williams_options_out_of_range_are_refused() {
+    let scene = floor_and_box(false, POINT);
+    let bad = [
+        (WilliamsOptions { map_size: 0, ..Default::default() }, "map size 0"),
+        (WilliamsOptions { map_size: 20_000, ..Default::default() }, "map size 20000"),
+        (WilliamsOptions { filter: ShadowFilter::Pcf(4), ..Default::default() }, "kernel size 4"),
+        (WilliamsOptions { filter: ShadowFilter::SoftEdge(65), ..Default::default() }, "kernel size 65"),
+        (WilliamsOptions { bias: Some(f64::NAN), ..Default::default() }, "bias NaN"),
+        (WilliamsOptions { slope_bias: -1.0, ..Default::default() }, "slope bias -1"),
+    ];
+    for (williams, want) in bad {
+        let shadow_options = ShadowOptions { williams, ..Default::default() };
+        let opts = RenderOptions { shadows: ShadowMethod::Williams, shadow_options, ..Default::default() };
+        let err = umbra::render(&scene, &opts).unwrap_err().to_string();
+        assert!(err.starts_with("williams: ") && err.contains(want), "{err}");
+    }
+}
+
+#[test]
 fn seed_gaussian_weights() {
     let taps = umbra::shadow::williams::seed_gaussian_taps();
     assert_eq!(taps.len(), 15);

@@ -58,6 +58,14 @@ fn bad_input_is_one_line_and_non_zero() {
     let out = umbra().args(["render", "x.toml", "--shadows", "magic"]).output().unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("known: none"));
+
+    let good = d.join("good.toml");
+    std::fs::write(&good, "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n").unwrap();
+    let out = umbra().arg("render").arg(&good).args(["--shadows", "williams", "--pcf-size", "2"]).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("kernel size 2"), "{err}");
 }
 
 #[test]

@@ -19,6 +19,7 @@
 //! Gaussian, and used when shading).
 
 use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
+use crate::error::{Error, Result};
 use crate::scene::{Camera, LightSample};
 use crate::stats::Counters;
 use crate::view::{DepthPlane, ScreenPolygon, View};
@@ -26,6 +27,7 @@ use crate::visibility::{rasterize, Run};
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
+use wide::f32x4;
 
 /// How the shadow-map comparison is filtered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,6 +67,35 @@ impl Default for WilliamsOptions {
             cull_front: false,
             map_storage: MapStorage::default(),
         }
+    }
+}
+
+impl WilliamsOptions {
+    /// The largest map side accepted (a 16,384² map takes a gigabyte).
+    pub const MAX_MAP_SIZE: u32 = 16_384;
+
+    /// The largest kernel side accepted for PCF and the soft-edged filter.
+    pub const MAX_KERNEL: u32 = 63;
+
+    /// Checks that the options can be carried out: a map side of 1 to
+    /// [`Self::MAX_MAP_SIZE`] texels, an odd kernel side of 1 to [`Self::MAX_KERNEL`], and
+    /// biases that are finite and not negative.
+    pub fn check(&self) -> Result<()> {
+        let fail = |what: String| Err(Error::Invalid(format!("williams: {what}")));
+        if !(1..=Self::MAX_MAP_SIZE).contains(&self.map_size) {
+            return fail(format!("map size {} is not in 1..={}", self.map_size, Self::MAX_MAP_SIZE));
+        }
+        if let ShadowFilter::Pcf(n) | ShadowFilter::SoftEdge(n) = self.filter {
+            if n.is_multiple_of(2) || n > Self::MAX_KERNEL {
+                return fail(format!("kernel size {n} is not odd and in 1..={}", Self::MAX_KERNEL));
+            }
+        }
+        for (name, v) in [("bias", self.bias.unwrap_or(0.0)), ("slope bias", self.slope_bias)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return fail(format!("{name} {v} is not a finite number ≥ 0"));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -227,109 +258,158 @@ impl DepthMap {
 
     /// Pass 2 along a run: the lit value at each point `h0 + i·step` (homogeneous, `w > 0`)
     /// under a `(2r+1)²` kernel, with bias `b0 + b1 × depth` where `(b0, b1)` is `constant`
-    /// plus `slope` texels. The run is taken in batches: first each point is located in
-    /// the map (straight-line arithmetic, two divisions), then its kernel is compared.
-    fn lit_run(&self, h0: DVec4, step: DVec4, constant: f64, slope: f64, r: usize, out: &mut [f32]) {
-        const BATCH: usize = 64;
+    /// plus `slope` texels. The run is taken in batches: first every point of a batch is
+    /// located in the map, four at a time in vector registers, then every kernel is
+    /// compared.
+    fn lit_run(
+        &self,
+        h0: DVec4,
+        step: DVec4,
+        (constant, slope): (f64, f64),
+        r: usize,
+        batch: &mut Located,
+        out: &mut [f32],
+    ) {
         let [rx, ry, rz] = self.rows;
-        let at = |h: DVec4| DVec4::new(rx.dot(h), ry.dot(h), rz.dot(h), h.w);
+        // In single precision from here: its rounding (a few parts in 10⁷ of the depth) is
+        // far below any bias, and the map holds single-precision nearness anyway.
+        let at = |h: DVec4| DVec4::new(rx.dot(h), ry.dot(h), rz.dot(h), h.w).as_vec4().to_array();
         let (l0, dl) = (at(h0), at(step));
         let (t0, t1) = self.proj.texel_size();
-        let (b0, b1) = (constant + slope * t0, slope * t1);
-        let mut located = [Located::default(); BATCH];
+        let (b0, b1) = ((constant + slope * t0) as f32, (slope * t1) as f32);
         for (b, out) in out.chunks_mut(BATCH).enumerate() {
-            let located = &mut located[..out.len()];
-            let first = (b * BATCH) as f64;
-            for (i, p) in located.iter_mut().enumerate() {
-                let l = l0 + dl * (first + i as f64);
-                *p = match self.proj {
-                    // `Z_map + bias < z` means shadow, that is `1/Z_map > 1/(z − bias)`.
+            let groups = out.len().div_ceil(4);
+            for g in 0..groups {
+                let t = f32x4::splat((b * BATCH + 4 * g) as f32) + f32x4::new([0.0, 1.0, 2.0, 3.0]);
+                // The four points in light space.
+                let [x, y, z, w] = [0, 1, 2, 3].map(|c| f32x4::splat(l0[c]) + f32x4::splat(dl[c]) * t);
+                let (px, py, threshold) = match self.proj {
+                    // `Z_map + bias < z` means shadow, that is `1/Z_map > 1/(z − bias)` with
+                    // `z = Z/w`: the threshold is `w / (Z(1 − b1) − b0·w)`. A point behind
+                    // the light, or within the bias of it, is lit: it goes far outside the
+                    // map.
                     Projection::Perspective(_) => {
-                        let q = 1.0 / l.z;
-                        let denom = l.z * (1.0 - b1) - b0 * l.w;
-                        let threshold = if denom > 0.0 { l.w / denom } else { f64::INFINITY };
-                        if l.z > 0.0 {
-                            Located::new(l.x * q, l.y * q, threshold)
-                        } else {
-                            Located::BEHIND
-                        }
+                        let denom = z * (1.0 - b1) - w * b0;
+                        let ahead = z.simd_gt(0.0) & denom.simd_gt(0.0);
+                        let q = f32x4::ONE / z;
+                        let far = f32x4::splat(f32::NEG_INFINITY);
+                        (ahead.select(x * q, far), ahead.select(y * q, far), ahead.select(w / denom, -far))
                     }
                     // The map holds `−Z_map`: shadow when `−Z_map > bias − z`.
                     Projection::Ortho { .. } => {
-                        let q = 1.0 / l.w;
-                        Located::new(l.x * q, l.y * q, b0 - l.z * q)
+                        let q = f32x4::ONE / w;
+                        (x * q, y * q, f32x4::splat(b0) - z * q)
                     }
                 };
+                batch.put(g, px, py, threshold, r, self.size);
             }
-            self.filter(located, r, out);
+            self.filter(batch, r, out);
         }
     }
 
     /// Compares each texel of the `(2r+1)²` kernel around each located point with the
     /// point's threshold, then averages the answers — never the depths. Texels outside the
     /// map count as lit: nothing was recorded there.
-    fn filter(&self, located: &[Located], r: usize, out: &mut [f32]) {
-        // The common radii get loops of their own, unrolled.
-        match r {
-            0 => self.filter_with(located, 0, out),
-            1 => self.filter_with(located, 1, out),
-            _ => self.filter_with(located, r, out),
-        }
-    }
-
-    #[inline(always)]
-    fn filter_with(&self, located: &[Located], r: usize, out: &mut [f32]) {
+    fn filter(&self, batch: &Located, r: usize, out: &mut [f32]) {
         let (n, stride) = (self.size as usize, (self.size + PAD) as usize);
         let width = 2 * r + 1;
         let share = 1.0 / (width * width) as f32;
-        let (lo, hi) = (r as f32, (n - r) as f32);
-        for (p, o) in located.iter().zip(out) {
-            let lit = if p.x >= lo && p.y >= lo && p.x < hi && p.y < hi {
-                // The whole kernel lies inside the map.
-                let corner = (p.y as usize - r) * stride + p.x as usize - r;
-                let block = &self.nearness[corner..corner + (width - 1) * stride + width];
-                let mut lit = 0;
-                for row in 0..width {
-                    for texel in &block[row * stride..row * stride + width] {
-                        lit += u32::from(*texel <= p.threshold);
-                    }
+        let len = out.len();
+        let thresholds = &batch.threshold.as_flattened()[..len];
+        let corners = batch.row.as_flattened().iter().zip(batch.col.as_flattened());
+        let corners = corners.map(|(&row, &col)| row as usize * stride + col as usize);
+        let kernels = out.iter_mut().zip(corners).zip(thresholds).map(|((o, c), &t)| (o, c, t));
+        // Kernels wholly inside the map (the others, which start at 0, are redone below).
+        match r {
+            0 => {
+                for (o, c, t) in kernels {
+                    *o = f32::from(u8::from(self.nearness[c] <= t));
                 }
-                lit
-            } else {
-                // Texel cells, with points far outside kept far enough that their kernel
-                // misses the map.
-                let cell = |v: f32| v.clamp(-(width as f32), (n + width) as f32).floor() as i64;
-                let (cx, cy, r) = (cell(p.x), cell(p.y), r as i64);
-                let mut lit = 0;
-                for ty in cy - r..=cy + r {
-                    for tx in cx - r..=cx + r {
-                        let inside = (0..n as i64).contains(&tx) && (0..n as i64).contains(&ty);
-                        lit += u32::from(!inside || self.nearness[ty as usize * stride + tx as usize] <= p.threshold);
-                    }
+            }
+            // 3×3: each row's three texels and the one after them (which the row's padding
+            // guarantees is there), compared four at a time, the fourth answer dropped.
+            1 => {
+                let keep = f32x4::new([1.0, 1.0, 1.0, 0.0]);
+                for (o, c, t) in kernels {
+                    let block = &self.nearness[c..c + 2 * stride + 4];
+                    let row = |k: usize| {
+                        let texels: [f32; 4] = block[k * stride..][..4].try_into().unwrap_or_default();
+                        f32x4::new(texels).simd_le(t) & keep
+                    };
+                    *o = (row(0) + row(1) + row(2)).reduce_add() * share;
                 }
-                lit
-            };
-            *o = lit as f32 * share;
+            }
+            _ => {
+                let span = (width - 1) * stride + width;
+                for (o, c, t) in kernels {
+                    let block = &self.nearness[c..c + span];
+                    let lit: u32 = (0..width)
+                        .map(|row| {
+                            block[row * stride..][..width].iter().map(|&texel| u32::from(texel <= t)).sum::<u32>()
+                        })
+                        .sum();
+                    *o = lit as f32 * share;
+                }
+            }
+        }
+        // Kernels reaching over the edge, texel by texel, with points far outside kept far
+        // enough that their kernel misses the map.
+        let cell = |v: f32| v.clamp(-(width as f32), (n + width) as f32).floor() as i64;
+        let (xs, ys) = (batch.x.as_flattened(), batch.y.as_flattened());
+        let mut outside = batch.outside & (u64::MAX >> (BATCH - len));
+        while outside != 0 {
+            let i = outside.trailing_zeros() as usize;
+            outside &= outside - 1;
+            let (cx, cy, r) = (cell(xs[i]), cell(ys[i]), r as i64);
+            let mut lit = 0;
+            for ty in cy - r..=cy + r {
+                for tx in cx - r..=cx + r {
+                    let inside = (0..n as i64).contains(&tx) && (0..n as i64).contains(&ty);
+                    let texel = || self.nearness[ty as usize * stride + tx as usize];
+                    lit += u32::from(!inside || texel() <= thresholds[i]);
+                }
+            }
+            out[i] = lit as f32 * share;
         }
     }
 }
 
-/// A point located in a shadow map: texel coordinates, and the nearness above which a
-/// texel hides it.
-#[derive(Debug, Clone, Copy, Default)]
+/// Points located in a map per batch (at most 64: [`Located::outside`] is a bit set).
+const BATCH: usize = 64;
+
+/// A batch of points located in a shadow map, in groups of four: texel coordinates, the
+/// nearness above which a texel hides the point, and the texel where its `(2r+1)²` kernel
+/// starts, for points whose kernel lies wholly inside the map (0 for the others, which
+/// are marked in `outside`).
 struct Located {
-    x: f32,
-    y: f32,
-    threshold: f32,
+    x: [[f32; 4]; BATCH / 4],
+    y: [[f32; 4]; BATCH / 4],
+    threshold: [[f32; 4]; BATCH / 4],
+    row: [[i32; 4]; BATCH / 4],
+    col: [[i32; 4]; BATCH / 4],
+    outside: u64,
+}
+
+impl Default for Located {
+    fn default() -> Self {
+        let zero = [[0.0; 4]; BATCH / 4];
+        Located { x: zero, y: zero, threshold: zero, row: [[0; 4]; BATCH / 4], col: [[0; 4]; BATCH / 4], outside: 0 }
+    }
 }
 
 impl Located {
-    /// Behind a perspective map's light: far outside the map, so lit.
-    const BEHIND: Located = Located { x: f32::NEG_INFINITY, y: f32::NEG_INFINITY, threshold: f32::INFINITY };
-
-    #[inline]
-    fn new(x: f64, y: f64, threshold: f64) -> Self {
-        Located { x: x as f32, y: y as f32, threshold: threshold as f32 }
+    /// Stores group `g`, four points at texel coordinates `(x, y)` in a map `size` texels
+    /// wide, for a kernel of radius `r`.
+    #[inline(always)]
+    fn put(&mut self, g: usize, x: f32x4, y: f32x4, threshold: f32x4, r: usize, size: u32) {
+        let (lo, hi) = (r as f32, (size as usize).saturating_sub(r) as f32);
+        let inside = x.simd_ge(lo) & y.simd_ge(lo) & x.simd_lt(hi) & y.simd_lt(hi);
+        // Truncation is the floor for the points inside, where these are not negative.
+        let corner = |v: f32x4| inside.select(v - lo, f32x4::ZERO).fast_trunc_int().to_array();
+        (self.x[g], self.y[g], self.threshold[g]) = (x.to_array(), y.to_array(), threshold.to_array());
+        (self.row[g], self.col[g]) = (corner(y), corner(x));
+        let outside = u64::from(!inside.to_bitmask() & 0xf) << (4 * g);
+        self.outside = self.outside & !(0xf << (4 * g)) | outside;
     }
 }
 
@@ -433,9 +513,9 @@ impl LightMaps {
 
     /// Pass 2 along a run (see [`DepthMap::lit_run`]); a cube's run is cut where the face
     /// holding its points changes.
-    fn lit_run(&self, h0: DVec4, step: DVec4, constant: f64, slope: f64, r: usize, out: &mut [f32]) {
+    fn lit_run(&self, h0: DVec4, step: DVec4, bias: (f64, f64), r: usize, batch: &mut Located, out: &mut [f32]) {
         match self {
-            LightMaps::Single(map) => map.lit_run(h0, step, constant, slope, r, out),
+            LightMaps::Single(map) => map.lit_run(h0, step, bias, r, batch, out),
             LightMaps::Cube(faces, s) => {
                 let face = |i: usize| {
                     let h = h0 + step * i as f64;
@@ -445,7 +525,7 @@ impl LightMaps {
                 while a < out.len() {
                     let f = face(a);
                     let b = (a + 1..out.len()).find(|&i| face(i) != f).unwrap_or(out.len());
-                    faces[f].lit_run(h0 + step * a as f64, step, constant, slope, r, &mut out[a..b]);
+                    faces[f].lit_run(h0 + step * a as f64, step, bias, r, batch, &mut out[a..b]);
                     a = b;
                 }
             }
@@ -472,6 +552,8 @@ pub struct Williams<'a> {
     options: WilliamsOptions,
     bias: f64,
     maps: Vec<LightMaps>,
+    /// Each visible polygon's centroid, where its slope-scaled bias is taken.
+    centroids: Vec<DVec3>,
     /// Soft-edge filter: each sample's blurred screen buffer.
     blurred: Vec<Vec<f32>>,
 }
@@ -484,60 +566,71 @@ impl<'a> Williams<'a> {
         let samples: Vec<_> = ctx.all_samples().collect();
         let maps = samples.iter().map(|&(_, _, s)| LightMaps::new(ctx, s, &options, counters)).collect();
         counters.add("map_texels", (options.map_size as u64).pow(2));
-        let mut stage = Williams { ctx, options, bias, maps, blurred: Vec::new() };
-        if let ShadowFilter::SoftEdge(k) = stage.options.filter {
-            stage.blurred =
-                samples.iter().enumerate().map(|(i, &(l, s, _))| stage.soft_edge_buffer(i, l, s, k)).collect();
+        let scene = ctx.scene;
+        let centroids = (0..scene.polygons.len())
+            .into_par_iter()
+            .map(|i| if ctx.visible[i] { crate::geometry::centroid(scene.verts(i)) } else { DVec3::ZERO })
+            .collect();
+        let mut stage = Williams { ctx, options, bias, maps, centroids, blurred: Vec::new() };
+        if let ShadowFilter::SoftEdge(_) = stage.options.filter {
+            stage.blurred = samples.iter().map(|&(l, s, _)| stage.soft_edge_buffer(l, s)).collect();
         }
         stage
     }
 
+    /// The radius of the filter's kernel, in texels.
+    fn kernel_radius(&self) -> usize {
+        match self.options.filter {
+            ShadowFilter::Nearest => 0,
+            ShadowFilter::Pcf(n) | ShadowFilter::SoftEdge(n) => (n.max(1) | 1) as usize / 2,
+        }
+    }
+
     /// Pass 2 for the pixels of `run` on line `line` (written to `out`): the
-    /// filtered lit value of flat sample `k` under a `size × size` kernel. The visible
-    /// point, in homogeneous form `(eye·D − dist·ray, D)` with `D = n·ray`, is linear in x
-    /// along the line, so it is stepped rather than recomputed. The slope-scaled bias takes
-    /// the polygon's angle to the light at its centroid, once per polygon, as
-    /// `glPolygonOffset` does.
-    fn lookup_run(&self, k: usize, sample: LightSample, line: u32, run: &Run, size: u32, out: &mut [f32]) {
-        let (poly, x0) = (run.poly as usize, run.x0);
+    /// filtered lit value of sample `s` of light `light`. The visible point, in homogeneous
+    /// form `(eye·D − dist·ray, D)` with `D = n·ray`, is linear in the ray, so it is stepped
+    /// along the line rather than recomputed. The slope-scaled bias takes the polygon's
+    /// angle to the light at its centroid, once per polygon, as `glPolygonOffset` does.
+    fn lookup_run(&self, light: usize, s: usize, line: u32, run: &Run, batch: &mut Located, out: &mut [f32]) {
+        let poly = run.poly as usize;
         let view = self.ctx.view;
         let plane = &self.ctx.scene.polygons[poly].plane;
-        let yc = line as f64 + 0.5;
-        let point_h = |xc: f64| {
-            let ray = view.ray(xc, yc);
+        let dist = plane.distance(view.eye);
+        let point_h = |ray: DVec3| {
             let d = plane.n.dot(ray);
-            (view.eye * d - ray * plane.distance(view.eye)).extend(d)
+            (view.eye * d - ray * dist).extend(d)
         };
-        let h0 = point_h(x0 as f64 + 0.5);
-        let step = point_h(x0 as f64 + 1.5) - h0;
+        let h0 = point_h(view.ray(run.x0 as f64 + 0.5, line as f64 + 0.5));
+        let step = point_h(view.ray_step());
         // Keep w > 0 so the maps' divisions read the right way round.
         let flip = if h0.w < 0.0 { -1.0 } else { 1.0 };
-        let c = crate::geometry::centroid(self.ctx.scene.verts(poly));
-        let (l, _) = sample.toward(c);
+        let (l, _) = self.ctx.samples[light][s].toward(self.centroids[poly]);
         let cos = plane.n.dot(l).abs().max(1e-3);
         let tan = ((1.0 - cos * cos).sqrt() / cos).min(10.0);
         // A wider kernel reaches texels farther along the slope.
-        let r = (size / 2) as usize;
+        let r = self.kernel_radius();
         let slope = self.options.slope_bias * (r + 1) as f64 * tan;
-        self.maps[k].lit_run(h0 * flip, step * flip, self.bias, slope, r, out);
+        let map = &self.maps[self.ctx.sample_index(light, s)];
+        map.lit_run(h0 * flip, step * flip, (self.bias, slope), r, batch, out);
     }
 
     /// Seed 002: the N×N PCF term of every visible pixel in a screen-sized buffer (1 where
     /// nothing is seen, or the sample is on the polygon's unseen side), blurred horizontally
     /// then vertically with the seed's 15 taps.
-    fn soft_edge_buffer(&self, k: usize, light: usize, s: usize, size: u32) -> Vec<f32> {
+    fn soft_edge_buffer(&self, light: usize, s: usize) -> Vec<f32> {
         let view = self.ctx.view;
         let (w, h) = (view.width as usize, view.height as usize);
         let sample = self.ctx.samples[light][s];
         let mut term = vec![1.0f32; w * h];
         term.par_chunks_mut(w).zip(&self.ctx.runs.lines).enumerate().for_each(|(y, (row, runs))| {
+            let mut batch = Located::default();
             for run in runs {
                 let plane = &self.ctx.scene.polygons[run.poly as usize].plane;
                 if !sample.on_seen_side(plane, view.eye) {
                     row[run.x0 as usize..run.x1 as usize].fill(0.0);
                     continue;
                 }
-                self.lookup_run(k, sample, y as u32, run, size, &mut row[run.x0 as usize..run.x1 as usize]);
+                self.lookup_run(light, s, y as u32, run, &mut batch, &mut row[run.x0 as usize..run.x1 as usize]);
             }
         });
         let taps = seed_gaussian_taps();
@@ -585,12 +678,14 @@ pub fn seed_gaussian_taps() -> Vec<(i64, f32)> {
 
 impl ShadowStage for Williams<'_> {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
-        Box::new(Walker { stage: self, lookups: 0, last: (0, 0, 0) })
+        Box::new(Walker { stage: self, batch: Box::default(), lookups: 0, last: (0, 0, 0) })
     }
 }
 
 struct Walker<'s> {
     stage: &'s Williams<'s>,
+    /// Room for the points being looked up.
+    batch: Box<Located>,
     lookups: u64,
     /// The last run and the texels compared per pixel.
     last: (u32, u32, u32),
@@ -606,13 +701,10 @@ impl ShadowWalker for Walker<'_> {
             lit.copy_from_slice(&st.blurred[k][row + run.x0 as usize..row + run.x1 as usize]);
             return;
         }
-        let size = match st.options.filter {
-            ShadowFilter::Pcf(n) => n.max(1) | 1,
-            _ => 1,
-        };
-        st.lookup_run(k, st.ctx.samples[light][sample], line, run, size, lit);
+        st.lookup_run(light, sample, line, run, &mut self.batch, lit);
+        let width = 2 * st.kernel_radius() as u32 + 1;
         self.lookups += lit.len() as u64;
-        self.last = (run.x0, run.x1, size * size);
+        self.last = (run.x0, run.x1, width * width);
     }
 
     fn decision(&self) -> Decision {
