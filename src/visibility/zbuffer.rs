@@ -36,6 +36,9 @@ pub trait Depth: Copy + PartialOrd + Send + Sync {
     const ZERO: Self;
     /// From a depth-plane value.
     fn from_f64(v: f64) -> Self;
+    /// The value `i` pixels along a span that starts at `z0` and changes by `a` per pixel,
+    /// in the buffer's own precision (from the start, not accumulated).
+    fn along(z0: Self, a: Self, i: i32) -> Self;
 }
 
 impl Depth for f64 {
@@ -44,6 +47,9 @@ impl Depth for f64 {
     fn from_f64(v: f64) -> Self {
         v
     }
+    fn along(z0: Self, a: Self, i: i32) -> Self {
+        z0 + a * i as f64
+    }
 }
 
 impl Depth for f32 {
@@ -51,6 +57,9 @@ impl Depth for f32 {
     const ZERO: Self = 0.0;
     fn from_f64(v: f64) -> Self {
         v as f32
+    }
+    fn along(z0: Self, a: Self, i: i32) -> Self {
+        z0 + a * i as f32
     }
 }
 
@@ -103,6 +112,26 @@ pub fn rasterize<D: Depth>(
     depth.resize(w * h as usize, D::ZERO);
     let band = crate::render::band_height(h);
     let chunk = w * band as usize;
+    // The polygons each band meets, in drawing order (a counting sort by band).
+    let bands = h.div_ceil(band) as usize;
+    let band_range = |r: &Range<u32>| (r.start / band) as usize..r.end.div_ceil(band) as usize;
+    let mut start = vec![0usize; bands + 1];
+    for r in &spans {
+        for b in band_range(r) {
+            start[b + 1] += 1;
+        }
+    }
+    for b in 0..bands {
+        start[b + 1] += start[b];
+    }
+    let mut members = vec![0u32; start[bands]];
+    let mut next = start.clone();
+    for (i, r) in spans.iter().enumerate() {
+        for b in band_range(r) {
+            members[next[b]] = i as u32;
+            next[b] += 1;
+        }
+    }
     let mut id_chunks: Vec<&mut [u32]> = ids.chunks_mut(chunk).collect();
     id_chunks.resize_with(depth.len().div_ceil(chunk), || &mut []);
     let counts: Vec<(u64, u64)> = depth
@@ -116,28 +145,26 @@ pub fn rasterize<D: Depth>(
             ids.fill(u32::MAX);
             let mut table = EdgeTable::new(h);
             let (mut tests, mut writes) = (0u64, 0u64);
-            for (p, r) in screen.iter().zip(&spans) {
-                if r.end <= lines.start || r.start >= lines.end {
-                    continue;
-                }
+            for p in members[start[bi]..start[bi + 1]].iter().map(|&i| &screen[i as usize]) {
                 for_each_span(&mut table, &[&p.ring], width, h, lines.clone(), |y, x0, x1| {
-                    let z0 = p.depth.inv_z(x0 as f64 + 0.5, y as f64 + 0.5);
-                    let (a, b) = ((y - y0) as usize * w + x0 as usize, (y - y0) as usize * w + x1 as usize);
+                    let z0 = D::from_f64(p.depth.inv_z(x0 as f64 + 0.5, y as f64 + 0.5));
+                    let a = D::from_f64(p.depth.a);
+                    let (start, end) = ((y - y0) as usize * w + x0 as usize, (y - y0) as usize * w + x1 as usize);
                     tests += (x1 - x0) as u64;
                     // Counted locally: a counter outside the closure would be read and
                     // written through memory at every pixel.
                     let mut span_writes = 0;
                     if ids.is_empty() {
                         // Depth only (a shadow map): branch-free, so it vectorises.
-                        for (i, d) in depth[a..b].iter_mut().enumerate() {
-                            let z = D::from_f64(z0 + p.depth.a * i as f64);
+                        for (d, i) in depth[start..end].iter_mut().zip(0..) {
+                            let z = D::along(z0, a, i);
                             let nearer = z > *d;
                             span_writes += u32::from(nearer);
                             *d = if nearer { z } else { *d };
                         }
                     } else {
-                        for ((d, id), i) in depth[a..b].iter_mut().zip(&mut ids[a..b]).zip(0..) {
-                            let z = D::from_f64(z0 + p.depth.a * i as f64);
+                        for ((d, id), i) in depth[start..end].iter_mut().zip(&mut ids[start..end]).zip(0..) {
+                            let z = D::along(z0, a, i);
                             if z > *d {
                                 (*d, *id) = (z, p.poly);
                                 span_writes += 1;
