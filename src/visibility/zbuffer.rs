@@ -112,24 +112,11 @@ pub fn rasterize<D: Depth>(
     depth.resize(w * h as usize, D::ZERO);
     let band = crate::render::band_height(h);
     let chunk = w * band as usize;
-    // The polygons each band meets, in drawing order (a counting sort by band).
-    let bands = h.div_ceil(band) as usize;
-    let band_range = |r: &Range<u32>| (r.start / band) as usize..r.end.div_ceil(band) as usize;
-    let mut start = vec![0usize; bands + 1];
-    for r in &spans {
-        for b in band_range(r) {
-            start[b + 1] += 1;
-        }
-    }
-    for b in 0..bands {
-        start[b + 1] += start[b];
-    }
-    let mut members = vec![0u32; start[bands]];
-    let mut next = start.clone();
+    // The polygons each band meets, in drawing order.
+    let mut members = vec![Vec::new(); h.div_ceil(band) as usize];
     for (i, r) in spans.iter().enumerate() {
-        for b in band_range(r) {
-            members[next[b]] = i as u32;
-            next[b] += 1;
+        for b in r.start / band..r.end.div_ceil(band) {
+            members[b as usize].push(i);
         }
     }
     let mut id_chunks: Vec<&mut [u32]> = ids.chunks_mut(chunk).collect();
@@ -145,7 +132,7 @@ pub fn rasterize<D: Depth>(
             ids.fill(u32::MAX);
             let mut table = EdgeTable::new(h);
             let (mut tests, mut writes) = (0u64, 0u64);
-            for p in members[start[bi]..start[bi + 1]].iter().map(|&i| &screen[i as usize]) {
+            for p in members[bi].iter().map(|&i| &screen[i]) {
                 for_each_span(&mut table, &[&p.ring], width, h, lines.clone(), |y, x0, x1| {
                     let z0 = D::from_f64(p.depth.inv_z(x0 as f64 + 0.5, y as f64 + 0.5));
                     let a = D::from_f64(p.depth.a);
