@@ -39,6 +39,7 @@ pub mod error;
 pub mod frame;
 pub mod generate;
 pub mod geometry;
+pub mod reference;
 pub mod reflection;
 pub mod render;
 pub mod scan;

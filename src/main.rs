@@ -50,8 +50,9 @@ struct ShadowArgs {
     /// eye is in shadow).
     #[arg(long, default_value = "zpass", value_parser = parse::<Counting>)]
     crow_count: Counting,
-    /// Crow and stencil-volume: give every polygon its own volume instead of building closed
-    /// meshes' volumes on their silhouettes (to measure what silhouettes save).
+    /// Crow and stencil-volume: give every polygon its own volume instead of merging the
+    /// sides that neighbouring polygons share (to measure what merging saves: only
+    /// silhouette and boundary edges keep sides).
     #[arg(long)]
     no_silhouettes: bool,
     /// Williams: texels along each side of a shadow map.

@@ -105,8 +105,8 @@ fn planar_shadows_are_exact_on_the_receiver_under_one_box() {
         let scene = floor_and_box(true, light);
         let want = frame(&scene, VisibilityMethod::RayCast, ShadowMethod::RayCast);
         let got = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::Planar);
-        assert!(assert_light_agree(&want, &got, "planar") > 10000);
-        assert!(shadowed_interior(&want) > 300, "{}", shadowed_interior(&want));
+        assert!(assert_light_agree(&scene, &want, &got, "planar").compared > 10000);
+        assert!(shadowed(&want) > 300, "{}", shadowed(&want));
     }
 }
 

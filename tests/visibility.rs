@@ -1,5 +1,5 @@
-//! Scanline and z-buffer visibility agree with the ray-cast reference at every interior pixel,
-//! on every example scene and on hundreds of random scenes.
+//! Scanline and z-buffer visibility agree with the ray-cast reference at every pixel but ties
+//! (see `umbra::reference`), on every example scene and on hundreds of random scenes.
 
 mod common;
 
@@ -14,8 +14,8 @@ fn example_scenes_agree_with_ray_cast() {
         let reference = frame(&scene, VisibilityMethod::RayCast, ShadowMethod::None);
         for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
             let got = frame(&scene, v, ShadowMethod::None);
-            let n = assert_ids_agree(&reference, &got, &format!("{} {v}", path.display()));
-            assert!(n > 1000, "{}: too few interior pixels ({n})", path.display());
+            let a = assert_ids_agree(&scene, &reference, &got, &format!("{} {v}", path.display()));
+            assert!(a.compared > 1000, "{}: too few pixels ({a:?})", path.display());
         }
     }
 }
@@ -35,8 +35,8 @@ fn random_scenes_agree_with_ray_cast() {
             .count();
         let reference = frame(&scene, VisibilityMethod::RayCast, ShadowMethod::None);
         for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
-            compared +=
-                assert_ids_agree(&reference, &frame(&scene, v, ShadowMethod::None), &format!("seed {seed} {v}"));
+            let got = frame(&scene, v, ShadowMethod::None);
+            compared += assert_ids_agree(&scene, &reference, &got, &format!("seed {seed} {v}")).compared;
         }
     }
     assert!(compared > 300 * 2 * 500);
@@ -55,7 +55,7 @@ fn generated_benchmark_scenes_agree() {
     for (i, scene) in scenes.iter().enumerate() {
         let reference = frame(scene, VisibilityMethod::RayCast, ShadowMethod::None);
         for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
-            assert_ids_agree(&reference, &frame(scene, v, ShadowMethod::None), &format!("generated {i} {v}"));
+            assert_ids_agree(scene, &reference, &frame(scene, v, ShadowMethod::None), &format!("generated {i} {v}"));
         }
     }
 }

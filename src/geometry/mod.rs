@@ -2,6 +2,7 @@
 //! `SCENE_FORMAT.md` section 2, clipping by a plane, point-in-polygon by the even-odd rule,
 //! and Weiler-Atherton polygon clipping ([`weiler_atherton`]).
 
+pub mod even_odd;
 pub mod weiler_atherton;
 
 use glam::{DVec2, DVec3};

@@ -38,8 +38,9 @@ pub struct ShadowOptions {
     pub prefilter: bool,
     /// Crow: how the shadow volumes are counted along the line of sight (default z-pass).
     pub crow_count: volumes::Counting,
-    /// Crow and stencil volumes: build closed meshes' volumes on their silhouette edges
-    /// (default true); `false` gives every polygon its own volume, to measure the saving.
+    /// Crow and stencil volumes: merge the sides that neighbouring polygons share, so that
+    /// only silhouette and boundary edges keep sides (default true); `false` gives every
+    /// polygon its own volume, to measure the saving.
     pub silhouettes: bool,
     /// Williams' shadow maps: resolution, bias, filter, culling.
     pub williams: WilliamsOptions,

@@ -1,35 +1,51 @@
 //! Shadow volumes (Crow 1977): the region a polygon hides from a light sample, bounded by
 //! *shadow polygons*. Shared by Crow's per-span counting and by the stencil-buffer stage.
 //!
-//! - **Closed meshes** (every edge shared by exactly two of the object's polygons, running
-//!   opposite ways, and no face split into a fan): one volume per object, its sides built on
-//!   the *silhouette edges* only (an edge between a polygon facing the light and one facing
-//!   away), capped in front by the polygons facing the light and at the back by those
-//!   polygons pushed away from the light.
-//! - **Everything else** (open meshes, edges shared by more than two polygons, inconsistent
-//!   winding, loose polygons): one volume per polygon, bounded by a side on each of its
-//!   edges and capped by the polygon itself and by its copy pushed away — a per-polygon
-//!   volume never leaks, whatever its neighbours.
+//! Every casting polygon has a volume: the points behind it as seen from the light sample,
+//! bounded by a *side* on each of its edges (the edge pushed away from the light), a *front
+//! cap* (the polygon itself) and a *back cap* (the polygon pushed away to infinity). A point
+//! is in shadow when it lies inside at least one volume, so the count of volumes holding a
+//! point is exactly the number of casting polygons that cross its segment to the light:
+//! this holds whatever the meshes are (open, closed, non-manifold, wound either way) and
+//! wherever the light is (outside a closed mesh, inside it, on its surface).
+//!
+//! The sides of neighbouring polygons on a shared edge lie in one plane, so they are merged
+//! (Bergeron 1986, "A general version of Crow's shadow volumes"): on each edge the sides of
+//! the polygons sharing it are summed with their orientations, and one side is kept with the
+//! net weight. Between two polygons that both face the light (or both face away) the two
+//! sides cancel; on a silhouette edge of a closed mesh they add up to weight 2 (the volumes of
+//! the polygon turned to the light and of the one turned away both end there); on an open
+//! mesh's boundary the weight is 1. Only silhouette and boundary edges make sides, as in
+//! Crow's closed-mesh construction, without its assumptions: Crow's single volume per object
+//! (sides on the silhouette, caps on the polygons facing the light) counts zero for a light
+//! inside the mesh, for points seen on the inside of an inward-wound mesh, and for a light on
+//! the mesh's surface, where the summed volumes count right.
+//!
+//! Kept apart, each with a volume of its own that never counts on its own face: the pieces
+//! of a non-planar face split into a fan (section 2: they never shadow each other), and a
+//! self-intersecting polygon, whose inside is decided by the even-odd rule: it is cut into
+//! trapezoids covering its even-odd region ([`crate::geometry::even_odd`]), since sides on its
+//! own edges would count its doubly wound parts twice (the nonzero rule).
 //!
 //! Volumes are extruded to infinity in homogeneous coordinates: a side on edge `a → b` is
 //! `[a, b, (b − L, 0), (a − L, 0)]` (for a directional light `[a, b, (d, 0)]`, the two far
 //! corners being the one point at infinity along `d`), and a back cap is its front cap's
 //! directions from the light, on the plane at infinity, behind everything. Nothing is cut
 //! short, whatever the scene's size or how close the light is to a polygon. Each shadow
-//! polygon knows its outward side, which gives its sign in the count: +1 where the eye sees
-//! it from outside (entering the volume), −1 from inside.
+//! polygon knows its outward side, which gives its sign in the count: +weight where the eye
+//! sees it from outside (entering the volume), −weight from inside.
 //!
 //! Which polygons a count needs: z-pass counts what lies between the eye and the visible
 //! point, so it needs the sides and the **near caps** — each volume's cross-section with the
-//! near plane, found by projecting its front-cap polygons from the light onto the part of the
-//! near plane the image sees (the eye's own count, pixel by pixel: Bergeron 1986). The front
-//! caps are scene polygons (never in front of a visible point) and the back caps lie beyond
+//! near plane, found by projecting its front cap from the light onto the part of the near
+//! plane the image sees (the eye's own count, pixel by pixel: Bergeron 1986). The front caps
+//! are scene polygons (never in front of a visible point) and the back caps lie beyond
 //! everything, so z-pass needs neither. Z-fail counts what lies behind the visible point, so
 //! it needs the sides and both caps, and no near caps. Naive z-pass leaves the near caps out.
 
 use super::projection::{edge_on, light_side, Projector};
 use super::ShadowContext;
-use crate::geometry::Plane;
+use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane};
 use crate::scene::LightSample;
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -89,14 +105,16 @@ pub struct ShadowPolygon {
     pub verts: Vec<DVec4>,
     /// Its plane; `None` for a back cap, which lies on the plane at infinity.
     pub plane: Option<Plane>,
-    /// +1 when the eye sees the side facing out of the volume, −1 when it sees the inside.
+    /// The polygon's weight in the count (how many volumes it bounds: 1, or 2 on a merged
+    /// silhouette edge), positive when the eye sees the side facing out of the volume,
+    /// negative when it sees the inside.
     pub sign: i32,
     /// Which part of the boundary it is.
     pub part: Part,
     /// For a front cap: the scene polygon it coincides with.
     pub lies_on: Option<u32>,
-    /// For a per-polygon volume: the face id whose volume it bounds (a face never shadows
-    /// itself, fan pieces included).
+    /// For a volume kept apart (a fan piece, a piece of a self-intersecting polygon): the
+    /// face whose volume it bounds, which it never shadows.
     pub owner_face: Option<u32>,
 }
 
@@ -108,38 +126,154 @@ pub fn shadow_polygons(
     counting: Counting,
     counters: &mut Counters,
 ) -> Vec<ShadowPolygon> {
-    let scene = ctx.scene;
-    let eye = ctx.view.eye;
-    let casts = |i: usize| !edge_on(scene, i, sample, ctx.extent);
-    let finite = |v: DVec3| v.extend(1.0);
-    let away = |v: DVec3| match sample {
-        LightSample::Point(s) => (v - s).extend(0.0),
-        LightSample::Directional(d) => d.extend(0.0),
-    };
-    // The sign of a finite polygon through `at` whose outward normal is `outward`.
-    let sign = |outward: DVec3, at: DVec3| if outward.dot(eye - at) > 0.0 { 1 } else { -1 };
-    let mut out = Vec::new();
-    let (near_plane, near_rect) = ctx.view.near_rectangle();
-    let mut proj = Projector::default();
-    let mut add_caps = |out: &mut Vec<ShadowPolygon>, poly: usize, owner: Option<u32>| {
-        let verts = scene.verts(poly);
-        let plane = scene.polygons[poly].plane;
-        match counting {
+    let mut b = Builder::new(ctx, sample, counting);
+    let casts = |i: usize| !edge_on(ctx.scene, i, sample, ctx.extent);
+    // Step 1: the merged sides, one per edge whose net weight is not zero.
+    let (mut weight1, mut weight2) = (0u64, 0u64);
+    for e in &adjacency.edges {
+        let sharing = &adjacency.sharing[e.first as usize..(e.first + e.count) as usize];
+        let w = b.net_weight(e.a, e.b, sharing.iter().filter(|s| casts(s.poly as usize)));
+        if w != 0 {
+            b.push_side(e.a, e.b, w, None);
+            if w.abs() == 1 {
+                weight1 += 1;
+            } else {
+                weight2 += 1;
+            }
+        }
+    }
+    // Step 2: the caps of every merged polygon.
+    for &p in adjacency.merged.iter().filter(|&&p| casts(p as usize)) {
+        b.push_caps(ctx.scene.verts(p as usize), p as usize, None);
+    }
+    // Step 3: the volumes kept apart, each with its own sides and caps.
+    for piece in adjacency.apart.iter().filter(|piece| casts(piece.poly as usize)) {
+        let owner = Some(ctx.scene.polygons[piece.poly as usize].face);
+        let v = &piece.verts;
+        for k in 0..v.len() {
+            let (a, c) = (v[k], v[(k + 1) % v.len()]);
+            let w = b.net_weight_one(a, c, piece.poly as usize);
+            if w != 0 {
+                b.push_side(a, c, w, owner);
+            }
+        }
+        b.push_caps(v, piece.poly as usize, owner);
+    }
+    let out = b.out;
+    counters.add("merged_edges", adjacency.edges.len() as u64);
+    counters.add("polygons_apart", adjacency.apart.len() as u64);
+    counters.add("sides_weight_1", weight1);
+    counters.add("sides_weight_2", weight2);
+    for (part, name) in [
+        (Part::Side, "shadow_polygons_side"),
+        (Part::FrontCap, "shadow_polygons_front_cap"),
+        (Part::BackCap, "shadow_polygons_back_cap"),
+        (Part::NearCap, "shadow_polygons_near_cap"),
+    ] {
+        counters.add(name, out.iter().filter(|p| p.part == part).count() as u64);
+    }
+    out
+}
+
+/// Builds one light sample's shadow polygons.
+struct Builder<'c> {
+    ctx: &'c ShadowContext<'c>,
+    sample: LightSample,
+    counting: Counting,
+    near: (Plane, [DVec3; 4]),
+    proj: Projector,
+    out: Vec<ShadowPolygon>,
+}
+
+impl<'c> Builder<'c> {
+    fn new(ctx: &'c ShadowContext<'c>, sample: LightSample, counting: Counting) -> Self {
+        let near = ctx.view.near_rectangle();
+        Builder { ctx, sample, counting, near, proj: Projector::default(), out: Vec::new() }
+    }
+
+    /// The normal of the plane through edge `a → b` and the light (not normalised; zero when
+    /// the light lies on the edge's line).
+    fn edge_plane(&self, a: DVec3, b: DVec3) -> DVec3 {
+        match self.sample {
+            LightSample::Point(s) => (b - a).cross(s - a),
+            LightSample::Directional(d) => (b - a).cross(d),
+        }
+    }
+
+    /// +1 when the side of polygon `poly` on its edge `from → to` (its interior on the left
+    /// of `from → to` about its normal) faces out along `m`, the edge plane of `a → b`, −1
+    /// when it faces the other way. The side faces out of the volume, away from the
+    /// polygon's interior.
+    fn orientation(&self, m: DVec3, from: DVec3, to: DVec3, poly: usize) -> i32 {
+        let inward = self.ctx.scene.polygons[poly].plane.n.cross(to - from);
+        if m.dot(inward) <= 0.0 {
+            1
+        } else {
+            -1
+        }
+    }
+
+    /// The summed orientation, along the edge plane of `a → b`, of the sides that the
+    /// polygons in `sharing` put on that edge.
+    fn net_weight<'s>(&self, a: DVec3, b: DVec3, sharing: impl Iterator<Item = &'s Sharing>) -> i32 {
+        let m = self.edge_plane(a, b);
+        sharing
+            .map(|s| {
+                let (from, to) = if s.forward { (a, b) } else { (b, a) };
+                self.orientation(m, from, to, s.poly as usize)
+            })
+            .sum()
+    }
+
+    /// The orientation of one polygon's side on its edge `a → b`.
+    fn net_weight_one(&self, a: DVec3, b: DVec3, poly: usize) -> i32 {
+        self.orientation(self.edge_plane(a, b), a, b, poly)
+    }
+
+    /// A side on edge `a → b` of weight `|w|`, facing out along the edge plane of `a → b`
+    /// times the sign of `w`.
+    fn push_side(&mut self, a: DVec3, b: DVec3, w: i32, owner: Option<u32>) {
+        let m = self.edge_plane(a, b) * w.signum() as f64;
+        let n = m.normalize();
+        if !n.is_finite() {
+            return; // the light lies on the edge's line: the side has no area
+        }
+        let verts = match self.sample {
+            LightSample::Point(_) => vec![finite(a), finite(b), self.away(b), self.away(a)],
+            LightSample::Directional(_) => vec![finite(a), finite(b), self.away(a)],
+        };
+        let sign = self.eye_sign(n, a) * w.abs();
+        self.out.push(ShadowPolygon {
+            verts,
+            plane: Some(Plane::new(n, a)),
+            sign,
+            part: Part::Side,
+            lies_on: None,
+            owner_face: owner,
+        });
+    }
+
+    /// The caps of the volume of `verts` (on scene polygon `poly`) that `self.counting` needs.
+    fn push_caps(&mut self, verts: &[DVec3], poly: usize, owner: Option<u32>) {
+        let plane = self.ctx.scene.polygons[poly].plane;
+        match self.counting {
             Counting::ZFail => {
-                let toward = plane.n * light_side(&plane, sample);
-                out.push(ShadowPolygon {
+                let toward = plane.n * light_side(&plane, self.sample);
+                let sign = self.eye_sign(toward, verts[0]);
+                self.out.push(ShadowPolygon {
                     verts: verts.iter().map(|&v| finite(v)).collect(),
                     plane: Some(plane),
-                    sign: sign(toward, verts[0]),
+                    sign,
                     part: Part::FrontCap,
                     lies_on: Some(poly as u32),
                     owner_face: owner,
                 });
                 // For a directional light every direction away is the same point at
                 // infinity: the sides close the volume there and no back cap is needed.
-                if let LightSample::Point(_) = sample {
-                    out.push(ShadowPolygon {
-                        verts: verts.iter().map(|&v| away(v)).collect(),
+                if let LightSample::Point(_) = self.sample {
+                    let verts = verts.iter().map(|&v| self.away(v)).collect();
+                    self.out.push(ShadowPolygon {
+                        verts,
                         plane: None,
                         sign: -1,
                         part: Part::BackCap,
@@ -149,10 +283,11 @@ pub fn shadow_polygons(
                 }
             }
             Counting::ZPass => {
-                if proj.project(verts, &near_plane, &near_rect, sample) {
-                    out.push(ShadowPolygon {
-                        verts: proj.shadow.iter().map(|&v| finite(v)).collect(),
-                        plane: Some(near_plane),
+                let (near_plane, near_rect) = &self.near;
+                if self.proj.project(verts, near_plane, near_rect, self.sample) {
+                    self.out.push(ShadowPolygon {
+                        verts: self.proj.shadow.iter().map(|&v| finite(v)).collect(),
+                        plane: Some(*near_plane),
                         sign: 1,
                         part: Part::NearCap,
                         lies_on: None,
@@ -162,173 +297,156 @@ pub fn shadow_polygons(
             }
             Counting::NaiveZPass => {}
         }
-    };
-    // A side on edge a -> b of polygon `poly` (whose interior lies left of a -> b about its
-    // normal): outward is away from the polygon's interior.
-    let side = |a: DVec3, b: DVec3, poly: usize, owner: Option<u32>| {
-        let n = scene.polygons[poly].plane.n;
-        let inward = n.cross(b - a);
-        let (m, verts) = match sample {
-            LightSample::Point(s) => ((b - a).cross(s - a), vec![finite(a), finite(b), away(b), away(a)]),
-            LightSample::Directional(d) => ((b - a).cross(d), vec![finite(a), finite(b), away(a)]),
-        };
-        let outward = if m.dot(inward) <= 0.0 { m } else { -m };
-        ShadowPolygon {
-            verts,
-            plane: Some(Plane::new(outward.normalize(), a)),
-            sign: sign(outward, a),
-            part: Part::Side,
-            lies_on: None,
-            owner_face: owner,
-        }
-    };
+    }
 
-    let (mut closed, mut open, mut silhouette) = (0u64, 0u64, 0u64);
-    for (polys, edges) in &adjacency.objects {
-        match edges {
-            Some(edges) => {
-                closed += 1;
-                // Turned to the light: the light strictly on the polygon's front side.
-                let faces_light = |p: usize| {
-                    let plane = &scene.polygons[p].plane;
-                    match sample {
-                        LightSample::Point(s) => plane.distance(s) > 0.0,
-                        LightSample::Directional(d) => plane.n.dot(d) < 0.0,
-                    }
-                };
-                for &(p, q, a, b) in edges {
-                    let (lp, lq) = (faces_light(p), faces_light(q));
-                    if lp != lq {
-                        silhouette += 1;
-                        out.push(if lp { side(a, b, p, None) } else { side(b, a, q, None) });
-                    }
-                }
-                for &p in polys.iter().filter(|&&p| faces_light(p) && casts(p)) {
-                    add_caps(&mut out, p, None);
-                }
-            }
-            None => {
-                open += 1;
-                for &p in polys.iter().filter(|&&p| casts(p)) {
-                    let owner = Some(scene.polygons[p].face);
-                    let v = scene.verts(p);
-                    for k in 0..v.len() {
-                        out.push(side(v[k], v[(k + 1) % v.len()], p, owner));
-                    }
-                    add_caps(&mut out, p, owner);
-                }
-            }
+    /// `v` pushed away from the light to infinity.
+    fn away(&self, v: DVec3) -> DVec4 {
+        match self.sample {
+            LightSample::Point(s) => (v - s).extend(0.0),
+            LightSample::Directional(d) => d.extend(0.0),
         }
     }
-    counters.add("closed_objects", closed);
-    counters.add("open_objects", open);
-    counters.add("silhouette_edges", silhouette);
-    for (part, name) in [
-        (Part::Side, "shadow_polygons_side"),
-        (Part::FrontCap, "shadow_polygons_front_cap"),
-        (Part::BackCap, "shadow_polygons_back_cap"),
-        (Part::NearCap, "shadow_polygons_near_cap"),
-    ] {
-        counters.add(name, out.iter().filter(|p| p.part == part).count() as u64);
+
+    /// The sign of a finite polygon through `at` whose outward normal is `outward`: +1 when
+    /// the eye is on its outward side.
+    fn eye_sign(&self, outward: DVec3, at: DVec3) -> i32 {
+        if outward.dot(self.ctx.view.eye - at) > 0.0 {
+            1
+        } else {
+            -1
+        }
     }
-    // The volumes (one per casting face) that hold the eye: what naive z-pass gets wrong.
-    let (dir, tmax) = match sample {
-        LightSample::Point(s) => (s - eye, 1.0),
-        LightSample::Directional(d) => (-d, f64::INFINITY),
-    };
-    let holding = adjacency
-        .objects
-        .iter()
-        .flat_map(|o| &o.0)
-        .filter(|&&i| casts(i) && crate::bvh::hit(scene, i, eye, dir).is_some_and(|t| t > 0.0 && t < tmax));
-    counters.add("volumes_containing_eye", holding.count() as u64);
-    out
 }
 
-/// Which casting objects are closed, and their edges: worked out once per scene, whatever
-/// the light.
+fn finite(v: DVec3) -> DVec4 {
+    v.extend(1.0)
+}
+
+/// The casting polygons' edges merged by position, worked out once per scene, whatever the
+/// light.
 #[derive(Debug, Clone, Default)]
 pub struct Adjacency {
-    /// Per object with casting polygons: its polygons, and for a closed, consistently wound
-    /// object (every edge shared by exactly two of its polygons, running opposite ways, no
-    /// face split into a fan) each edge once as `(p, q, a, b)`: it runs `a -> b` in polygon
-    /// `p` and `b -> a` in `q`.
-    objects: Vec<(Vec<usize>, Option<Vec<Edge>>)>,
+    /// Every edge of a merged polygon, once.
+    edges: Vec<MergedEdge>,
+    /// The polygons sharing each edge (`edges[i].first..+count`).
+    sharing: Vec<Sharing>,
+    /// The merged polygons (their caps).
+    merged: Vec<u32>,
+    /// The volumes kept apart.
+    apart: Vec<Apart>,
 }
 
-/// An edge of a closed object: it runs `a -> b` in polygon `p` and `b -> a` in polygon `q`.
-type Edge = (usize, usize, DVec3, DVec3);
+/// An edge between two vertex positions.
+#[derive(Debug, Clone, Copy)]
+struct MergedEdge {
+    a: DVec3,
+    b: DVec3,
+    first: u32,
+    count: u32,
+}
+
+/// A polygon on an edge: it runs `a → b` (`forward`) or `b → a`.
+#[derive(Debug, Clone, Copy)]
+struct Sharing {
+    poly: u32,
+    forward: bool,
+}
+
+/// A volume kept apart: a fan piece, or one trapezoid of a self-intersecting polygon.
+#[derive(Debug, Clone)]
+struct Apart {
+    poly: u32,
+    verts: Vec<DVec3>,
+}
+
+/// An edge keyed by its two welded end positions (the lesser first), with the polygon on it.
+struct KeyedEdge {
+    key: ([u64; 3], [u64; 3]),
+    a: DVec3,
+    b: DVec3,
+    on: Sharing,
+}
 
 impl Adjacency {
-    /// The adjacency of the scene's shadow-casting polygons, by object. Vertices are welded
-    /// by exact position. Without `silhouettes`, every object is treated as open (one volume
-    /// per polygon).
-    pub fn new(scene: &crate::Scene, silhouettes: bool) -> Self {
-        let casters: Vec<usize> = (0..scene.polygons.len()).filter(|&i| scene.casts_shadows(i)).collect();
-        // Weld: one id per distinct position, by sorting.
-        let mut keys: Vec<([u64; 3], u32)> = Vec::new();
-        for &p in &casters {
-            let poly = &scene.polygons[p];
-            for k in 0..poly.len {
-                let v = scene.vertices[(poly.start + k) as usize];
-                keys.push((v.to_array().map(f64::to_bits), poly.start + k));
+    /// The adjacency of the scene's shadow-casting polygons. Vertices are welded by exact
+    /// position. Without `merge`, every polygon keeps its own volume (to measure the saving).
+    pub fn new(scene: &crate::Scene, merge: bool) -> Self {
+        let mut adjacency = Adjacency::default();
+        let mut keyed = Vec::new();
+        for (p, poly) in scene.polygons.iter().enumerate() {
+            if !scene.casts_shadows(p) {
+                continue;
+            }
+            let verts = scene.verts(p);
+            let fan_piece = [p.checked_sub(1), Some(p + 1)]
+                .into_iter()
+                .flatten()
+                .any(|q| scene.polygons.get(q).is_some_and(|o| o.face == poly.face));
+            let axis = dominant_axis(poly.plane.n);
+            let ring: Vec<DVec2> = verts.iter().map(|&v| drop_axis(v, axis)).collect();
+            if even_odd::self_intersects(&ring) {
+                adjacency.keep_apart_even_odd(p, &ring, axis, &poly.plane);
+            } else if !merge || fan_piece {
+                adjacency.apart.push(Apart { poly: p as u32, verts: verts.to_vec() });
+            } else {
+                adjacency.merged.push(p as u32);
+                for k in 0..verts.len() {
+                    let (a, b) = (verts[k], verts[(k + 1) % verts.len()]);
+                    let (ka, kb) = (a.to_array().map(f64::to_bits), b.to_array().map(f64::to_bits));
+                    let on = |forward| Sharing { poly: p as u32, forward };
+                    keyed.push(if ka <= kb {
+                        KeyedEdge { key: (ka, kb), a, b, on: on(true) }
+                    } else {
+                        KeyedEdge { key: (kb, ka), a: b, b: a, on: on(false) }
+                    });
+                }
             }
         }
-        keys.sort_unstable();
-        let mut id = vec![0u32; scene.vertices.len()];
-        let mut next = 0u32;
-        for (i, (key, v)) in keys.iter().enumerate() {
-            if i > 0 && keys[i - 1].0 != *key {
-                next += 1;
+        adjacency.group(keyed);
+        adjacency
+    }
+
+    /// Keeps the even-odd region of self-intersecting polygon `p` (its ring `ring`, in the
+    /// plane's coordinates dropping `axis`) apart, as trapezoids.
+    fn keep_apart_even_odd(&mut self, p: usize, ring: &[DVec2], axis: usize, plane: &Plane) {
+        for t in even_odd::trapezoids(ring) {
+            let mut v: Vec<DVec3> = t.iter().map(|&q| lift(q, axis, plane)).collect();
+            v.dedup();
+            if v.len() < 3 {
+                continue; // no area
             }
-            id[*v as usize] = next;
+            // Wound as the polygon is, so that its sides know their inside.
+            if newell_normal(&v).dot(plane.n) < 0.0 {
+                v.reverse();
+            }
+            self.apart.push(Apart { poly: p as u32, verts: v });
         }
-        let mut objects: Vec<(u32, Vec<usize>)> = Vec::new();
-        for &p in &casters {
-            let o = scene.polygons[p].object;
-            match objects.last_mut() {
-                Some((last, polys)) if *last == o => polys.push(p),
-                _ => objects.push((o, vec![p])),
+    }
+
+    /// Groups the keyed edges by position: one merged edge each, with the polygons on it.
+    fn group(&mut self, mut keyed: Vec<KeyedEdge>) {
+        keyed.sort_unstable_by_key(|k| k.key);
+        for (i, k) in keyed.iter().enumerate() {
+            if i == 0 || keyed[i - 1].key != k.key {
+                let first = self.sharing.len() as u32;
+                self.edges.push(MergedEdge { a: k.a, b: k.b, first, count: 0 });
+            }
+            self.sharing.push(k.on);
+            if let Some(e) = self.edges.last_mut() {
+                e.count += 1;
             }
         }
-        let objects = objects
-            .into_iter()
-            .map(|(_, polys)| {
-                let edges = if silhouettes { closed_edges(scene, &polys, &id) } else { None };
-                (polys, edges)
-            })
-            .collect();
-        Adjacency { objects }
     }
 }
 
-fn closed_edges(scene: &crate::Scene, polys: &[usize], id: &[u32]) -> Option<Vec<Edge>> {
-    if polys.windows(2).any(|w| scene.polygons[w[0]].face == scene.polygons[w[1]].face) {
-        return None; // a face split into a fan (its pieces are consecutive)
+/// The point of `plane` whose projection dropping `axis` is `q`.
+fn lift(q: DVec2, axis: usize, plane: &Plane) -> DVec3 {
+    let n = plane.n;
+    match axis {
+        0 => DVec3::new(-(n.y * q.x + n.z * q.y + plane.d) / n.x, q.x, q.y),
+        1 => DVec3::new(q.y, -(n.z * q.x + n.x * q.y + plane.d) / n.y, q.x),
+        _ => DVec3::new(q.x, q.y, -(n.x * q.x + n.y * q.y + plane.d) / n.z),
     }
-    // Directed edges (from, to, polygon, index of `from` in the vertex array).
-    let mut directed: Vec<(u32, u32, usize, u32)> = Vec::new();
-    for &p in polys {
-        let poly = &scene.polygons[p];
-        for k in 0..poly.len {
-            let (a, b) = (poly.start + k, poly.start + (k + 1) % poly.len);
-            directed.push((id[a as usize], id[b as usize], p, a));
-        }
-    }
-    directed.sort_unstable();
-    if directed.windows(2).any(|w| (w[0].0, w[0].1) == (w[1].0, w[1].1)) {
-        return None; // the same edge twice the same way
-    }
-    let mut edges = Vec::new();
-    for &(a, b, p, va) in &directed {
-        let i = directed.binary_search_by(|e| (e.0, e.1).cmp(&(b, a))).ok()?;
-        if a < b {
-            let poly = &scene.polygons[p];
-            let vb = poly.start + (va - poly.start + 1) % poly.len;
-            edges.push((p, directed[i].2, scene.vertices[va as usize], scene.vertices[vb as usize]));
-        }
-    }
-    Some(edges)
 }
 
 /// A shadow polygon in screen space.

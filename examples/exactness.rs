@@ -1,0 +1,51 @@
+//! Renders a scene with every exact shadow stage behind both visibility stages and counts,
+//! at every pixel, where each differs from the ray-cast reference (face id or lit fraction).
+//!
+//! `cargo run --release --example exactness -- scene.toml [more.toml ...]`
+use umbra::shadow::volumes::Counting;
+use umbra::shadow::ShadowOptions;
+use umbra::{render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
+
+fn main() {
+    for path in std::env::args().skip(1) {
+        let scene = match Scene::load(&path) {
+            Ok(s) => s,
+            Err(e) => {
+                println!("{path}: {e}");
+                continue;
+            }
+        };
+        let go = |v, s, o: ShadowOptions| {
+            render(&scene, &RenderOptions { visibility: v, shadows: s, shadow_options: o, ..Default::default() })
+        };
+        let reference = go(VisibilityMethod::RayCast, ShadowMethod::RayCast, ShadowOptions::default()).unwrap().frame;
+        let d = ShadowOptions::default;
+        let stages = [
+            ("bk", ShadowMethod::BouknightKelley, d()),
+            ("awg", ShadowMethod::AthertonWeilerGreenberg, d()),
+            ("crow-zpass", ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZPass, ..d() }),
+            ("crow-zfail", ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZFail, ..d() }),
+            ("stencil-zpass", ShadowMethod::StencilVolume, ShadowOptions { crow_count: Counting::ZPass, ..d() }),
+            ("stencil-zfail", ShadowMethod::StencilVolume, ShadowOptions { crow_count: Counting::ZFail, ..d() }),
+        ];
+        for vis in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
+            for (name, s, o) in &stages {
+                match go(vis, *s, o.clone()) {
+                    Err(e) => println!("{path} {vis} {name}: error {e}"),
+                    Ok(out) => {
+                        let f = out.frame;
+                        let (mut ids, mut lit) = (0, 0);
+                        for k in 0..f.id.len() {
+                            if f.id[k] != reference.id[k] {
+                                ids += 1;
+                            } else if f.light.iter().zip(&reference.light).any(|(a, b)| a[k] != b[k]) {
+                                lit += 1;
+                            }
+                        }
+                        println!("{path} {vis} {name}: {ids} id, {lit} lit differ of {}", f.id.len());
+                    }
+                }
+            }
+        }
+    }
+}

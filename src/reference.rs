@@ -1,0 +1,111 @@
+//! The exact answer of `docs/scene-format.md` §3 at any point of the image plane, computed
+//! directly (one ray for the visible surface, one shadow ray per light sample), and the
+//! definition of a *tie* that the exactness tests use.
+//!
+//! A pixel is a **tie** when the answer at its centre (the face seen, and each light's lit
+//! fraction) is not the answer at every point within [`TIE_DELTA`] of a pixel around it
+//! (the eight points at `±TIE_DELTA` in x, y or both): the centre then lies, to within
+//! floating-point rounding, on a polygon's edge, on a shadow's edge, or on two coincident
+//! surfaces, where the contract lets either answer stand. Every other pixel has one right
+//! answer, and an exact stage must give it.
+
+use crate::bvh::Bvh;
+use crate::scene::{LightSample, Scene};
+use crate::view::View;
+
+/// How far (in pixels) a sample point moves to test for a tie.
+pub const TIE_DELTA: f64 = 1e-6;
+
+/// What a point of the image plane sees.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Answer {
+    /// The face id seen (`u32::MAX`: background).
+    pub face: u32,
+    /// Each light's lit fraction there (0 on background).
+    pub lit: Vec<f32>,
+}
+
+/// The exact answer at any image point, for checking the stages.
+pub struct Reference<'a> {
+    scene: &'a Scene,
+    view: View,
+    all: Bvh,
+    casters: Bvh,
+    samples: Vec<Vec<LightSample>>,
+    extent: f64,
+}
+
+impl<'a> Reference<'a> {
+    /// Builds the two ray-casting structures (every polygon; the shadow casters).
+    ///
+    /// ```
+    /// let scene = umbra::generate::cubes(1, false, 32, 24)?;
+    /// let oracle = umbra::reference::Reference::new(&scene);
+    /// let centre = oracle.at(16.5, 12.5);
+    /// assert_eq!(centre.lit.len(), scene.lights.len());
+    /// # Ok::<(), umbra::Error>(())
+    /// ```
+    pub fn new(scene: &'a Scene) -> Self {
+        let n = scene.polygons.len() as u32;
+        let casters = (0..n).filter(|&i| scene.casts_shadows(i as usize)).collect();
+        let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
+        Reference {
+            scene,
+            view: View::new(&scene.camera),
+            all: Bvh::new(scene, (0..n).collect()),
+            casters: Bvh::new(scene, casters),
+            samples: scene.lights.iter().map(|l| l.samples()).collect(),
+            extent,
+        }
+    }
+
+    /// The answer at image point `(x, y)` (pixel units; pixel `(px, py)`'s centre is
+    /// `(px + 0.5, py + 0.5)`).
+    pub fn at(&self, x: f64, y: f64) -> Answer {
+        let d = self.view.ray(x, y);
+        let far = self.view.far.unwrap_or(f64::INFINITY);
+        let Some((poly, _)) = self.all.closest(self.scene, self.view.eye, d, self.view.near, far) else {
+            return Answer { face: u32::MAX, lit: vec![0.0; self.samples.len()] };
+        };
+        let polygon = &self.scene.polygons[poly as usize];
+        let p = self.view.point_on(&polygon.plane, x, y);
+        let eps = 1e-9;
+        let lit = self
+            .samples
+            .iter()
+            .map(|samples| {
+                let reached = samples
+                    .iter()
+                    .filter(|s| {
+                        s.on_seen_side(&polygon.plane, self.view.eye)
+                            && !match **s {
+                                LightSample::Point(l) => {
+                                    self.casters.occluded(self.scene, p, l - p, eps, 1.0 - eps, polygon.face)
+                                }
+                                LightSample::Directional(dir) => self.casters.occluded(
+                                    self.scene,
+                                    p,
+                                    -dir,
+                                    eps * self.extent,
+                                    f64::INFINITY,
+                                    polygon.face,
+                                ),
+                            }
+                    })
+                    .count();
+                reached as f32 / samples.len() as f32
+            })
+            .collect();
+        Answer { face: polygon.face, lit }
+    }
+
+    /// Whether pixel `(px, py)` is a tie (see the module's definition).
+    pub fn is_tie(&self, px: u32, py: u32) -> bool {
+        let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
+        let centre = self.at(x, y);
+        let t = TIE_DELTA;
+        [(-t, -t), (0.0, -t), (t, -t), (-t, 0.0), (t, 0.0), (-t, t), (0.0, t), (t, t)]
+            .iter()
+            .any(|&(dx, dy)| self.at(x + dx, y + dy) != centre)
+    }
+}
