@@ -76,16 +76,33 @@ pub enum Error {
         /// The encoder's reason.
         source: image::ImageError,
     },
-    /// A request that the engine cannot carry out (an unknown method name, a scene built by
-    /// the API with values out of range, a method that does not apply to the scene).
+    /// A request that the engine cannot carry out: an unknown method name, an option or a
+    /// scene built by the API with values out of range, work beyond the memory budget.
     #[error("{0}")]
     Invalid(String),
+    /// A method that does not apply to this scene (planar shadows with no receiver).
+    #[error("{0}")]
+    NotApplicable(String),
+    /// A stage failed where it should not have: a defect in umbra, not in the input.
+    #[error("internal error (a defect in umbra; please report it): {0}")]
+    Internal(String),
 }
 
 impl Error {
     /// An input error at `loc`.
     pub fn input(loc: FileLoc, message: impl Into<String>) -> Self {
         Error::Input { loc, message: message.into() }
+    }
+}
+
+/// A number for a message: plain when it reads well, in scientific notation when it is very
+/// large or very small.
+pub(crate) fn num(x: f64) -> String {
+    let a = x.abs();
+    if a != 0.0 && !(1e-4..1e7).contains(&a) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
     }
 }
 

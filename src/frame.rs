@@ -58,12 +58,14 @@ impl Frame {
     }
 
     fn save(&self, img: image::DynamicImage, path: &Path) -> Result<()> {
-        img.save_with_format(path, image::ImageFormat::Png)
-            .map_err(|e| Error::Image { path: path.to_owned(), source: e })
+        write_png(img, path)
     }
 
-    /// The colour image, clamped to [0, 1], optionally raised to `1/gamma` for display.
+    /// The colour image, clamped to [0, 1], optionally raised to `1/gamma` for display. A
+    /// gamma outside [`GAMMA_RANGE`] (or not a number) is taken as none: check it first with
+    /// [`check_gamma`].
     pub fn color_image(&self, gamma: Option<f32>) -> image::RgbImage {
+        let gamma = gamma.filter(|g| GAMMA_RANGE.contains(g));
         let encode = |c: f32| {
             let c = c.clamp(0.0, 1.0);
             let c = gamma.map_or(c, |g| c.powf(1.0 / g));
@@ -87,14 +89,16 @@ impl Frame {
     /// `light<k>.png`: `round(255 * lit fraction)`, halves away from zero. A fraction that is
     /// `m/n` for the light's `n` samples (every exact stage's) is encoded from `m` and `n`,
     /// so a half is a half however the fraction was summed.
-    pub fn light_image(&self, k: usize) -> image::GrayImage {
+    /// `None` when the frame has no light `k`.
+    pub fn light_image(&self, k: usize) -> Option<image::GrayImage> {
         let n = self.light_samples.get(k).copied().unwrap_or(1).max(1) as f64;
-        image::GrayImage::from_fn(self.width, self.height, |x, y| {
-            let f = self.light[k][(y * self.width + x) as usize] as f64;
+        let light = self.light.get(k)?;
+        Some(image::GrayImage::from_fn(self.width, self.height, |x, y| {
+            let f = light[(y * self.width + x) as usize] as f64;
             let m = (f * n).round();
             let exact = if (f * n - m).abs() < 1e-4 { 255.0 * m / n } else { 255.0 * f };
             image::Luma([exact.round().clamp(0.0, 255.0) as u8])
-        })
+        }))
     }
 
     /// Draws polygons over a colour image: tinted inside (by the even-odd rule, with the
@@ -126,8 +130,11 @@ impl Frame {
         }
     }
 
-    /// Writes the colour image as PNG.
+    /// Writes the colour image as PNG (see [`check_gamma`] for `gamma`).
     pub fn save_png(&self, path: &Path, gamma: Option<f32>) -> Result<()> {
+        if let Some(g) = gamma {
+            check_gamma(g)?;
+        }
         self.save(self.color_image(gamma).into(), path)
     }
 
@@ -139,7 +146,9 @@ impl Frame {
         std::fs::create_dir_all(dir).map_err(|e| Error::Io { path: dir.to_owned(), source: e })?;
         self.save(self.id_image().into(), &dir.join("id.png"))?;
         for k in 0..self.light.len() {
-            self.save(self.light_image(k).into(), &dir.join(format!("light{k}.png")))?;
+            if let Some(img) = self.light_image(k) {
+                self.save(img.into(), &dir.join(format!("light{k}.png")))?;
+            }
         }
         if let Some(m) = &self.mirror_id {
             self.save(Self::ids_image(m, self.width, self.height).into(), &dir.join("mirror_id.png"))?;
@@ -184,6 +193,31 @@ impl Frame {
     }
 }
 
+/// The display gammas accepted: 0.1 to 10 (2.2 is the usual one).
+pub const GAMMA_RANGE: std::ops::RangeInclusive<f32> = 0.1..=10.0;
+
+/// `Ok` when `gamma` is a number in [`GAMMA_RANGE`].
+pub fn check_gamma(gamma: f32) -> Result<()> {
+    if GAMMA_RANGE.contains(&gamma) {
+        Ok(())
+    } else {
+        Err(Error::Invalid(format!(
+            "gamma {gamma} is not in {}..={} (2.2 is the usual display gamma)",
+            GAMMA_RANGE.start(),
+            GAMMA_RANGE.end()
+        )))
+    }
+}
+
+/// Encodes `img` as PNG in memory, then writes the file in one call, so that a failed write
+/// (a full disk, `/dev/full`) is an error and never a silently truncated file.
+pub(crate) fn write_png(img: image::DynamicImage, path: &Path) -> Result<()> {
+    let mut bytes = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| Error::Image { path: path.to_owned(), source: e })?;
+    std::fs::write(path, bytes).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -196,8 +230,8 @@ mod tests {
         f.light[0][0] = 0.5;
         f.light[1][0] = (0..1).map(|_| 1.0f32 / 6.0).sum();
         f.light[1][1] = (0..3).map(|_| 1.0f32 / 6.0).sum::<f32>();
-        assert_eq!(f.light_image(0).get_pixel(0, 0).0, [128]);
-        assert_eq!(f.light_image(1).get_pixel(0, 0).0, [43]);
-        assert_eq!(f.light_image(1).get_pixel(1, 0).0, [128]);
+        assert_eq!(f.light_image(0).expect("a light").get_pixel(0, 0).0, [128]);
+        assert_eq!(f.light_image(1).expect("a light").get_pixel(0, 0).0, [43]);
+        assert_eq!(f.light_image(1).expect("a light").get_pixel(1, 0).0, [128]);
     }
 }

@@ -65,9 +65,18 @@ fn floor(half: f64) -> Mesh {
     ]])
 }
 
+/// Refuses a generated scene of `polygons` polygons of `corners` corners each whose mesh
+/// and compiled polygons would not fit the memory budget (about 100 bytes a corner across
+/// the mesh, the world vertices, normals and the stages' per-polygon data).
+fn check_size(family: &str, polygons: u64, corners: u64) -> Result<()> {
+    let bytes = crate::budget::mul(polygons, crate::budget::mul(corners, 100) + 64);
+    crate::budget::check(format_args!("generate {family}: {polygons} polygons"), bytes)
+}
+
 /// A floor with an `n`×`n` grid of unit cubes (each as 12 triangles when `triangles`, else
 /// 6 quads) under a point light: 10×10 gives 1,201 polygons as triangles.
 pub fn cubes(n: u32, triangles: bool, width: u32, height: u32) -> Result<Scene> {
+    check_size("cubes", crate::budget::mul(n as u64 * n as u64, if triangles { 12 } else { 6 }), 4)?;
     let half = n as f64 + 1.0;
     let mut boxes = Mesh::default();
     for i in 0..n {
@@ -92,6 +101,7 @@ pub fn cubes(n: u32, triangles: bool, width: u32, height: u32) -> Result<Scene> 
 /// at every pixel), each turned a little so that neighbours' depths differ over the screen,
 /// lit from the side.
 pub fn stacked_quads(d: u32, width: u32, height: u32) -> Result<Scene> {
+    check_size("quads", d as u64, 4)?;
     let mut polys = Vec::new();
     let aspect = width as f64 / height as f64;
     for k in 0..d {
@@ -155,6 +165,7 @@ pub fn sphere_mesh(c: DVec3, r: f64, triangles: u32) -> Mesh {
 /// `count` spheres of about `triangles / count` triangles each, scattered on a floor by a
 /// seeded generator, under a point light.
 pub fn spheres(triangles: u32, count: u32, width: u32, height: u32) -> Result<Scene> {
+    check_size("spheres", triangles as u64 + 2 * count as u64, 3)?;
     let count = count.max(1);
     let side = (count as f64).sqrt().ceil() as u32;
     let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -304,6 +315,7 @@ pub fn random(seed: u64, opts: RandomOptions) -> Result<Scene> {
 /// uniformly, or clustered around its centre — over a floor, for Slater et al.'s study of
 /// polygon count, size and distribution.
 pub fn scattered(n: u32, size: f64, clustered: bool, width: u32, height: u32) -> Result<Scene> {
+    check_size("scattered triangles", n as u64, 3)?;
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mut tris = Vec::with_capacity(n as usize);
     for _ in 0..n {

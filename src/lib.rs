@@ -34,6 +34,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod budget;
 pub mod bvh;
 pub mod error;
 pub mod frame;

@@ -127,8 +127,9 @@ struct RenderArgs {
     /// Print the counters and times as one JSON object on standard output.
     #[arg(long)]
     stats: bool,
-    /// Encode the image with this display gamma (for example 2.2); default: linear values.
-    #[arg(long)]
+    /// Encode the image with this display gamma (0.1 to 10, for example 2.2); default:
+    /// linear values.
+    #[arg(long, value_parser = parse_gamma)]
     gamma: Option<f32>,
     /// Draw the shadow stage's own polygons for the first light sample over the image
     /// (shadow polygons, lit detail polygons, shadow-volume polygons).
@@ -301,6 +302,7 @@ fn scene_name(path: &std::path::Path) -> String {
 fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
+            check_png_name(&a.output)?;
             let scene = Scene::load(&a.scene)?;
             let opts = RenderOptions {
                 visibility: a.visibility,
@@ -315,13 +317,13 @@ fn run(cli: Cli) -> umbra::Result<()> {
             if a.debug.is_some() {
                 umbra::Frame::draw_outlines(&mut img, &out.outlines, [255, 40, 200]);
             }
-            img.save_with_format(&a.output, image::ImageFormat::Png)
-                .map_err(|e| Error::Image { path: a.output.clone(), source: e })?;
+            write_png(img, &a.output)?;
             if let Some(dir) = &a.aov {
                 out.frame.save_aovs(dir)?;
             }
             if a.stats {
-                println!("{}", serde_json::to_string(&out.stats).map_err(|e| Error::Invalid(e.to_string()))?);
+                let json = serde_json::to_string(&out.stats).map_err(|e| Error::Internal(e.to_string()))?;
+                stdout(&format!("{json}\n"))?;
             }
             Ok(())
         }
@@ -377,12 +379,15 @@ fn run(cli: Cli) -> umbra::Result<()> {
         Command::Trace(a) => {
             let scene = Scene::load(&a.scene)?;
             let t = umbra::study::trace::trace(&scene, a.line, a.shadows, &a.shadow.options(false)?)?;
-            if a.json {
-                println!("{}", serde_json::to_string_pretty(&t).map_err(|e| Error::Invalid(e.to_string()))?);
-            } else {
-                print!("{}", t.text(&scene, a.x));
+            if let Some(x) = a.x.filter(|&x| x >= scene.camera.width) {
+                return Err(Error::Invalid(format!("--x {x} is outside the image (width {})", scene.camera.width)));
             }
-            Ok(())
+            if a.json {
+                let json = serde_json::to_string_pretty(&t).map_err(|e| Error::Internal(e.to_string()))?;
+                stdout(&format!("{json}\n"))
+            } else {
+                stdout(&t.text(&scene, a.x))
+            }
         }
         Command::ExportShadows(e) => {
             let scene = Scene::load(&e.scene)?;
@@ -401,11 +406,46 @@ fn run(cli: Cli) -> umbra::Result<()> {
     }
 }
 
+/// Writes `text` to standard output; a failed write (a closed pipe, a full disk) is an error.
+fn stdout(text: &str) -> umbra::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| Error::Io { path: "standard output".into(), source: e })
+}
+
+/// Refuses an output name with an extension other than `.png` (only PNG is encoded; a name
+/// without one, such as `/dev/stdout`, gets PNG).
+fn check_png_name(path: &std::path::Path) -> umbra::Result<()> {
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if ext.is_none() || ext.as_deref() == Some("png") {
+        return Ok(());
+    }
+    Err(Error::Invalid(format!("{}: umbra writes PNG only; name the output file *.png", path.display())))
+}
+
+/// Writes the image as PNG, in one write so that a failed write is an error.
+fn write_png(img: image::RgbImage, path: &std::path::Path) -> umbra::Result<()> {
+    check_png_name(path)?;
+    let mut bytes = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| Error::Image { path: path.to_owned(), source: e })?;
+    std::fs::write(path, bytes).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+}
+
+fn parse_gamma(s: &str) -> Result<f32, String> {
+    let g: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+    umbra::frame::check_gamma(g).map(|()| g).map_err(|e| e.to_string())
+}
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("umbra: {e}");
+            use std::io::Write;
+            // Nothing more can be done if standard error is closed too.
+            let _ = writeln!(std::io::stderr(), "umbra: {e}");
             ExitCode::FAILURE
         }
     }

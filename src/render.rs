@@ -97,12 +97,20 @@ fn depth_complexity(screen: &[crate::view::ScreenPolygon], w: u32, h: u32) -> Ve
     count
 }
 
+/// Refuses a frame whose buffers (colour, face ids, lit fractions, the visibility stage's
+/// depth, per-pixel counters) would not fit [`crate::budget::MEMORY_BUDGET`].
+fn check_frame_memory(scene: &Scene, opts: &RenderOptions) -> Result<()> {
+    let (w, h) = (scene.camera.width as u64, scene.camera.height as u64);
+    let per_pixel = 32 + 4 * scene.lights.len() as u64 + if opts.pixel_counters { 12 } else { 0 };
+    crate::budget::check(format_args!("a {w}x{h} frame"), crate::budget::mul(w * h, per_pixel))
+}
+
 /// Renders `scene` with the chosen stages.
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     let start = Instant::now();
-    if opts.shadows == ShadowMethod::Williams {
-        opts.shadow_options.williams.check()?;
-    }
+    // The camera is a public field: a program may have changed it since the scene was built.
+    scene.camera.validate().map_err(crate::Error::Invalid)?;
+    check_frame_memory(scene, opts)?;
     let mut stats = Stats {
         visibility: opts.visibility.name().into(),
         shadows: opts.shadows.name().into(),
@@ -230,7 +238,28 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     if frame.mirror_id.is_some() {
         stats.time_ms.insert("reflections", ms(t.elapsed()));
     }
+    saturate(&mut frame.color);
     Ok(Rendered { frame, stats, outlines })
+}
+
+/// Every input is finite in single precision, but products of large ones can overflow: a
+/// channel that overflowed to infinity, or to NaN (infinity times zero, or less infinity),
+/// is set to the largest finite value, so no NaN or infinity ever reaches a pixel (it
+/// encodes as full brightness, as an overflow should).
+fn saturate(color: &mut [Vec3]) {
+    for c in color {
+        if !c.is_finite() {
+            *c = Vec3::new(fin(c.x), fin(c.y), fin(c.z));
+        }
+    }
+}
+
+fn fin(x: f32) -> f32 {
+    if x.is_nan() {
+        f32::MAX
+    } else {
+        x.clamp(-f32::MAX, f32::MAX)
+    }
 }
 
 /// A progress bar that appears only after a second, and only on a terminal.

@@ -68,8 +68,11 @@ pub struct ScreenPolygon {
 impl View {
     /// The view of `camera`.
     pub fn new(camera: &Camera) -> View {
-        let f = (camera.target - camera.eye).normalize();
-        let r = f.cross(camera.up).normalize();
+        // Scaled before normalising, so that huge or tiny vectors neither overflow nor
+        // underflow (the camera was validated: these are not zero).
+        let f = crate::geometry::unit(camera.target - camera.eye).unwrap_or(DVec3::NEG_Z);
+        let up = crate::geometry::unit(camera.up).unwrap_or(DVec3::Y);
+        let r = f.cross(up).normalize();
         let u = r.cross(f);
         View {
             eye: camera.eye,
@@ -223,10 +226,26 @@ impl View {
                 std::mem::swap(a, b);
             }
         }
+        // The guard band (10⁴ times the view's width): a polygon reaching beyond it is cut
+        // there, far off screen, so that screen coordinates stay small enough for the scan
+        // converter's arithmetic. Polygons within it (all but huge ones) are not touched.
+        let g = 1e4 * (self.t * self.aspect).max(self.t);
+        let band: [&dyn Fn(DVec3) -> f64; 4] =
+            [&|c| g * c.z - c.x, &|c| g * c.z + c.x, &|c| g * c.z - c.y, &|c| g * c.z + c.y];
+        for plane in band {
+            if a.iter().any(|&c| plane(c) < 0.0) {
+                clip_polygon(a, plane, b);
+                std::mem::swap(a, b);
+            }
+        }
         if a.len() < 3 {
             return false;
         }
         out.extend(a.iter().map(|&c| self.project(c)));
+        if !out.iter().all(|p| p.is_finite()) {
+            out.clear();
+            return false;
+        }
         true
     }
 

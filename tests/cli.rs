@@ -95,3 +95,88 @@ fn export_shadows_writes_an_obj_of_lit_detail_polygons() {
     // Every group names the source face it lies on.
     assert!(text.lines().filter(|l| l.starts_with("g sample0_face")).count() >= 10);
 }
+
+/// Runs umbra with `args`; returns (success, stderr).
+fn run(args: &[&str]) -> (bool, String) {
+    let out = umbra().args(args).output().unwrap();
+    (out.status.success(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// Asserts a failure with exactly one line on stderr, containing `want`.
+fn refused(args: &[&str], want: &str) {
+    let (ok, err) = run(args);
+    assert!(!ok, "{args:?} succeeded");
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    assert!(err.contains(want), "{args:?}: {err}");
+}
+
+const SMALL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robustness/crow_pentagram_even_odd.toml");
+
+#[test]
+fn failed_writes_are_errors() {
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full");
+    if full.is_err() {
+        return; // no /dev/full on this system
+    }
+    let out = umbra().args(["render", SMALL, "-o", "/dev/null", "--stats"]).stdout(full.unwrap()).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("standard output"));
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let out = umbra().args(["trace", SMALL, "--line", "30"]).stdout(full).output().unwrap();
+    assert!(!out.status.success());
+    refused(&["render", SMALL, "-o", "/dev/full"], "/dev/full");
+}
+
+#[test]
+fn options_are_checked_wherever_they_are_used() {
+    refused(&["render", SMALL, "-o", "x.jpg"], "PNG only");
+    refused(&["render", SMALL, "-o", "x.png", "--gamma", "0"], "gamma");
+    refused(&["render", SMALL, "-o", "x.png", "--gamma", "nan"], "gamma");
+    refused(&["trace", SMALL, "--line", "3", "--x", "5000"], "outside the image");
+    // Williams' options: the same checks from render, trace and compare.
+    let w = ["--shadows", "williams"];
+    refused(&[&["render", SMALL, "-o", "/dev/null", "--map-size", "2"][..], &w].concat(), "wider than the 2x2 map");
+    refused(&[&["render", SMALL, "-o", "/dev/null", "--map-size", "4", "--pcf-size", "5"][..], &w].concat(), "wider");
+    refused(&[&["trace", SMALL, "--line", "3", "--map-size", "0"][..], &w].concat(), "map size 0");
+    refused(&[&["trace", SMALL, "--line", "3", "--pcf-size", "2"][..], &w].concat(), "kernel size 2");
+    refused(&[&["trace", SMALL, "--line", "3", "--bias", "nan"][..], &w].concat(), "bias");
+    let d = tmp("compare-map");
+    let out = d.join("c");
+    refused(
+        &["compare", SMALL, "--shadows", "williams", "--map-size", "0", "--out", out.to_str().unwrap()],
+        "map size 0",
+    );
+    // A kernel as wide as the map is fine.
+    let (ok, err) = run(&[&["render", SMALL, "-o", "/dev/null", "--map-size", "3"][..], &w].concat());
+    assert!(ok, "{err}");
+}
+
+#[test]
+fn work_beyond_the_memory_budget_is_refused_before_it_starts() {
+    let d = tmp("budget");
+    let big = d.join("big.toml");
+    std::fs::write(
+        &big,
+        "[camera]\neye = [0.0, 2.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\nwidth = 32768\nheight = 32768\n\
+         [[object]]\npolygons = [[[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]]\n",
+    )
+    .unwrap();
+    refused(&["render", big.to_str().unwrap(), "-o", "/dev/null"], "memory budget");
+    let g = d.join("g.toml");
+    refused(&["generate", "cubes", "--n", "100000", "-o", g.to_str().unwrap()], "memory budget");
+    refused(&["generate", "spheres", "--triangles", "4000000000", "-o", g.to_str().unwrap()], "memory budget");
+    refused(
+        &["scale", "--sweep", "cubes", "--values", "1000000", "--out", d.join("s").to_str().unwrap()],
+        "memory budget",
+    );
+    // 4,096 samples of an area light, each with a 2048² cube map: refused with the estimate.
+    let area = d.join("area.toml");
+    std::fs::write(
+        &area,
+        "[camera]\neye = [0.0, 2.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\nwidth = 32\nheight = 24\n\
+         [[light]]\nkind = \"area\"\ncorner = [0.0, 4.0, 0.0]\nedge_u = [1.0, 0.0, 0.0]\nedge_v = [0.0, 0.0, 1.0]\nsamples = [64, 64]\n\
+         [[object]]\npolygons = [[[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]]\n",
+    )
+    .unwrap();
+    refused(&["render", area.to_str().unwrap(), "-o", "/dev/null", "--shadows", "williams"], "memory budget");
+}

@@ -75,10 +75,119 @@ fn light_keys_checked_per_kind() {
 
 #[test]
 fn camera_checks() {
+    // Each camera error names the line of the key that is wrong, not the table's.
     let e = load("[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 5.0]\n").unwrap_err();
-    assert!(e.starts_with("s.toml:1:") && e.contains("same point"), "{e}");
+    assert!(e.starts_with("s.toml:2:") && e.contains("same point"), "{e}");
     let e = load("[camera]\neye = [0.0, 5.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\n").unwrap_err();
     assert!(e.contains("up is parallel"), "{e}");
+    let e = load("[camera]\neye = [0.0, 2.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y = 1e-310\n").unwrap_err();
+    assert!(e.starts_with("s.toml:4:") && e.contains("fov_y") && e.contains("1e-310"), "{e}");
+    let e = load("[camera]\neye = [0.0, 2.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\nwidth = 0\n").unwrap_err();
+    assert!(e.starts_with("s.toml:4:") && e.contains("size"), "{e}");
+    // Huge but finite vectors are scaled before they are normalised: no overflow, no
+    // misleading error.
+    let s = load("[camera]\neye = [0.0, 2.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\nup = [1e308, 1e308, 0.0]\n").unwrap();
+    let v = umbra::view::View::new(&s.camera);
+    assert!(v.r.is_finite() && v.u.is_finite(), "{:?} {:?}", v.r, v.u);
+    let s = load(&format!("{CAMERA}[[light]]\nkind = \"directional\"\ndirection = [1e200, -1e200, 0.0]\n")).unwrap();
+    assert!(
+        matches!(s.lights[0].kind, umbra::scene::LightKind::Directional { direction } if (direction.length() - 1.0).abs() < 1e-12)
+    );
+}
+
+#[test]
+fn arrays_have_exactly_their_length() {
+    let e = load("[camera]\neye = [0.0, 2.0, 6.0, \"junk\"]\ntarget = [0.0, 0.0, 0.0]\n").unwrap_err();
+    assert!(e.starts_with("s.toml:2:") && e.contains("exactly 3"), "{e}");
+    let e = err("[[light]]\nkind = \"area\"\ncorner = [0.0, 5.0, 0.0]\nedge_u = [1.0, 0.0, 0.0]\nedge_v = [0.0, 0.0, 1.0]\nsamples = [2, 2, 3]\n");
+    assert!(e.starts_with("s.toml:9:") && e.contains("exactly 2"), "{e}");
+    let e = err("[[object]]\npolygons = [[[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0,1.0]]]\n");
+    assert!(e.starts_with("s.toml:5:") && e.contains("exactly 3"), "{e}");
+    let e = err("[[object]]\npolygons = [[[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0]]]\n");
+    assert!(e.starts_with("s.toml:5:"), "{e}");
+}
+
+#[test]
+fn values_beyond_single_precision_are_refused_where_written() {
+    let e = err("[[light]]\nkind = \"point\"\nposition = [0.0, 1.0, 0.0]\nintensity = 1e39\n");
+    assert!(e.starts_with("s.toml:7:") && e.contains("beyond single precision"), "{e}");
+    let e = err("[[material]]\nname = \"m\"\nks = 1e39\n");
+    assert!(e.starts_with("s.toml:6:") && e.contains("1e39"), "{e}");
+    let e = err("[[material]]\nname = \"m\"\ncolor = [1e39, 0.0, 0.0]\n");
+    assert!(e.starts_with("s.toml:6:"), "{e}");
+    let e = err("[[light]]\nkind = \"point\"\nposition = [0.0, 1.0, 0.0]\ncolor = [1e300, 0.0, 0.0]\n");
+    assert!(e.starts_with("s.toml:7:"), "{e}");
+    // Largest finite f32 values load, and the products that overflow never reach a pixel.
+    let s = load(&format!(
+        "{CAMERA}width = 16\nheight = 12\n[[light]]\nkind = \"point\"\nposition = [0.0, 1.0, 3.0]\nintensity = 3e38\ncolor = [3e38, 1.0, 0.0]\n\
+         [[material]]\nname = \"m\"\nkd = 3e38\nks = 3e38\n[[object]]\nmaterial = \"m\"\npolygons = [[[-2.0,-2.0,0.0],[2.0,-2.0,0.0],[2.0,2.0,0.0],[-2.0,2.0,0.0]]]\n"
+    ))
+    .unwrap();
+    let out = umbra::render(&s, &umbra::RenderOptions::default()).unwrap();
+    assert!(out.frame.color.iter().all(|c| c.is_finite()));
+}
+
+#[test]
+fn ranged_keys_name_themselves_and_their_line() {
+    let e = err("[[material]]\nname = \"m\"\nroughness = 0.0\n");
+    assert_eq!(e, "s.toml:6:13: material roughness must be > 0, got 0");
+    let e = err("[[material]]\nname = \"m\"\nkd = 0.5\nmirror = 2.0\n");
+    assert_eq!(e, "s.toml:7:10: material mirror must be in [0, 1], got 2");
+    let e =
+        err("[[light]]\nkind = \"spot\"\nposition = [0.0, 1.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\nexponent = -5.0\n");
+    assert_eq!(e, "s.toml:8:12: spot exponent must be >= 0, got -5");
+    let e = err("[[light]]\nkind = \"point\"\nposition = [0.0, 1.0, 0.0]\nattenuation = [0.0, 0.0, 0.0]\n");
+    assert!(e.starts_with("s.toml:7:") && e.contains("attenuation"), "{e}");
+}
+
+#[test]
+fn byte_order_marks_and_bad_encodings() {
+    let dir = std::env::temp_dir().join(format!("umbra-bom-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("m.obj"), "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let scene = format!("\u{feff}{CAMERA}[[object]]\nmesh = \"m.obj\"\n");
+    std::fs::write(dir.join("s.toml"), &scene).unwrap();
+    let s = Scene::load(dir.join("s.toml")).unwrap();
+    assert_eq!(s.polygons.len(), 1, "the BOM must not eat the first vertex");
+    let mut bad = scene.into_bytes();
+    bad.extend_from_slice(b"# \xFF\n");
+    std::fs::write(dir.join("bad.toml"), &bad).unwrap();
+    let e = Scene::load(dir.join("bad.toml")).unwrap_err().to_string();
+    assert!(e.contains("bad.toml:6") && e.contains("not UTF-8"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn transforms_that_overflow_are_refused() {
+    let e = err("[[object]]\nscale = 1e308\npolygons = [[[0.0,0.0,0.0],[10.0,0.0,0.0],[0.0,10.0,0.0]]]\n");
+    assert!(e.contains("beyond the range of f64"), "{e}");
+}
+
+#[test]
+fn huge_faces_load_in_linear_time() {
+    // 200,000 vertices on a circle: the diameter of the planarity rule is linear here.
+    let n = 200_000;
+    let mut obj = String::with_capacity(n * 40);
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        obj += &format!("v {} 0.5 {}\n", a.cos(), a.sin());
+    }
+    obj += "f";
+    for k in 1..=n {
+        obj += &format!(" {k}");
+    }
+    let mesh = umbra::scene::parse_obj(&obj, Path::new("big.obj")).unwrap();
+    let shape = umbra::geometry::classify_face(&mesh.positions);
+    assert!(matches!(shape, umbra::geometry::FaceShape::Planar(..)));
+}
+
+#[test]
+fn obj_vertices_take_three_numbers_and_an_optional_weight() {
+    let e = umbra::scene::parse_obj("v 0 0 0 1 7\n", Path::new("m.obj")).unwrap_err().to_string();
+    assert_eq!(e, "m.obj:1: 'v' takes at most four numbers, found '7'");
+    let e = umbra::scene::parse_obj("vn 0 0 1 1\n", Path::new("m.obj")).unwrap_err().to_string();
+    assert_eq!(e, "m.obj:1: 'vn' takes three numbers, found a fourth '1'");
+    assert!(umbra::scene::parse_obj("v 0 0 0 1\n", Path::new("m.obj")).is_ok());
 }
 
 #[test]

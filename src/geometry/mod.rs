@@ -41,13 +41,35 @@ pub fn newell_normal(verts: &[DVec3]) -> DVec3 {
     n
 }
 
+/// `v` scaled to unit length, safely for any finite `v`: it is first divided by its largest
+/// component, so a huge vector does not overflow and a tiny one does not underflow. `None`
+/// for the zero vector (or a non-finite one).
+pub fn unit(v: DVec3) -> Option<DVec3> {
+    let m = v.abs().max_element();
+    if !(m > 0.0 && m.is_finite()) {
+        return None;
+    }
+    Some((v / m).normalize())
+}
+
 /// The average of a polygon's vertices.
 pub fn centroid(verts: &[DVec3]) -> DVec3 {
     verts.iter().copied().sum::<DVec3>() / verts.len() as f64
 }
 
-/// The largest distance between two vertices.
+/// Faces with more vertices than this measure their size by their bounding box.
+pub const EXACT_DIAMETER_VERTICES: usize = 256;
+
+/// The length scale of a face's planarity and degeneracy rules: the largest distance between
+/// two vertices, for faces of up to [`EXACT_DIAMETER_VERTICES`] vertices; for larger faces the
+/// diagonal of their bounding box (between 1 and √3 times the diameter), which keeps a
+/// face of 200,000 vertices linear instead of quadratic.
 pub fn diameter(verts: &[DVec3]) -> f64 {
+    if verts.len() > EXACT_DIAMETER_VERTICES {
+        let Some(&first) = verts.first() else { return 0.0 };
+        let (lo, hi) = verts.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        return (hi - lo).length();
+    }
     let mut d2: f64 = 0.0;
     for (i, a) in verts.iter().enumerate() {
         for b in &verts[i + 1..] {

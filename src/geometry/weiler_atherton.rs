@@ -149,7 +149,9 @@ impl Vertices {
         let cell = ((p.x / self.eps).floor() as i64, (p.y / self.eps).floor() as i64);
         for dx in -1..=1 {
             for dy in -1..=1 {
-                if let Some(ids) = self.grid.get(&(cell.0 + dx, cell.1 + dy)) {
+                // Saturating: far-off points share the edge cells, and the distance test
+                // below still decides.
+                if let Some(ids) = self.grid.get(&(cell.0.saturating_add(dx), cell.1.saturating_add(dy))) {
                     if let Some(&i) = ids.iter().find(|&&i| self.pts[i as usize].distance(p) <= self.eps) {
                         return i;
                     }

@@ -31,14 +31,69 @@ impl<'de> Deserialize<'de> for Num {
     }
 }
 
-type V3 = [Num; 3];
+/// Exactly `N` finite numbers: a missing or an extra element is an error at the array.
+#[derive(Debug, Clone, Copy)]
+struct Arr<T, const N: usize>([T; N]);
 
-fn v3(v: V3) -> DVec3 {
-    DVec3::new(v[0].0, v[1].0, v[2].0)
+impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Deserialize<'de> for Arr<T, N> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V<T, const N: usize>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Visitor<'de> for V<T, N> {
+            type Value = Arr<T, N>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(f, "an array of exactly {N} numbers")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> std::result::Result<Arr<T, N>, A::Error> {
+                let mut out = [T::default(); N];
+                for (i, x) in out.iter_mut().enumerate() {
+                    *x = seq.next_element::<T>()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                if seq.next_element::<de::IgnoredAny>()?.is_some() {
+                    return Err(de::Error::invalid_length(N + 1, &self));
+                }
+                Ok(Arr(out))
+            }
+        }
+        d.deserialize_seq(V::<T, N>(std::marker::PhantomData))
+    }
 }
 
-fn c3(v: V3) -> Vec3 {
-    v3(v).as_vec3()
+impl Default for Num {
+    fn default() -> Self {
+        Num(0.0)
+    }
+}
+
+type V3 = Arr<Num, 3>;
+
+/// A finite number that single precision holds (colours, intensities and material
+/// coefficients are kept in f32; a larger value would become infinity there).
+#[derive(Debug, Clone, Copy, Default)]
+struct Num32(f32);
+
+impl<'de> Deserialize<'de> for Num32 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let x = Num::deserialize(d)?.0;
+        if x.abs() <= f32::MAX as f64 {
+            Ok(Num32(x as f32))
+        } else {
+            Err(de::Error::custom(format!(
+                "{} is beyond single precision (at most {:e} in size)",
+                crate::error::num(x),
+                f32::MAX
+            )))
+        }
+    }
+}
+
+type C3 = Arr<Num32, 3>;
+
+fn v3(v: V3) -> DVec3 {
+    DVec3::new(v.0[0].0, v.0[1].0, v.0[2].0)
+}
+
+fn c3(v: C3) -> Vec3 {
+    Vec3::new(v.0[0].0, v.0[1].0, v.0[2].0)
 }
 
 /// `scale = 2.0` or `scale = [sx, sy, sz]`.
@@ -94,37 +149,37 @@ struct RawScene {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawCamera {
-    eye: V3,
+    eye: Spanned<V3>,
     target: V3,
-    up: Option<V3>,
-    fov_y: Option<Num>,
-    width: Option<u32>,
-    height: Option<u32>,
-    near: Option<Num>,
-    far: Option<Num>,
+    up: Option<Spanned<V3>>,
+    fov_y: Option<Spanned<Num>>,
+    width: Option<Spanned<u32>>,
+    height: Option<Spanned<u32>>,
+    near: Option<Spanned<Num>>,
+    far: Option<Spanned<Num>>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawRender {
-    ambient: Option<V3>,
-    background: Option<V3>,
+    ambient: Option<C3>,
+    background: Option<C3>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawMaterial {
     name: Spanned<String>,
-    color: Option<V3>,
-    specular_color: Option<V3>,
-    ka: Option<Num>,
-    kd: Option<Num>,
-    ks: Option<Num>,
-    shininess: Option<Num>,
+    color: Option<C3>,
+    specular_color: Option<C3>,
+    ka: Option<Num32>,
+    kd: Option<Num32>,
+    ks: Option<Num32>,
+    shininess: Option<Spanned<Num32>>,
     model: Option<SpecularModel>,
-    roughness: Option<Num>,
-    fresnel: Option<Num>,
-    mirror: Option<Num>,
+    roughness: Option<Spanned<Num32>>,
+    fresnel: Option<Spanned<Num32>>,
+    mirror: Option<Spanned<Num32>>,
     shading: Option<ShadingMode>,
 }
 
@@ -141,17 +196,17 @@ enum RawLightKind {
 #[serde(deny_unknown_fields)]
 struct RawLight {
     kind: RawLightKind,
-    color: Option<V3>,
-    intensity: Option<Num>,
+    color: Option<C3>,
+    intensity: Option<Num32>,
     position: Option<V3>,
-    direction: Option<V3>,
-    cutoff: Option<Num>,
-    exponent: Option<Num>,
-    attenuation: Option<V3>,
+    direction: Option<Spanned<V3>>,
+    cutoff: Option<Spanned<Num>>,
+    exponent: Option<Spanned<Num>>,
+    attenuation: Option<Spanned<V3>>,
     corner: Option<V3>,
     edge_u: Option<V3>,
     edge_v: Option<V3>,
-    samples: Option<[u32; 2]>,
+    samples: Option<Spanned<Arr<u32, 2>>>,
 }
 
 #[derive(Deserialize)]
@@ -183,7 +238,8 @@ impl Scene {
     /// Loads a scene file; meshes are read relative to its folder.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
         let path = path.as_ref();
-        let src = std::fs::read_to_string(path).map_err(|e| Error::Io { path: path.to_owned(), source: e })?;
+        let bytes = std::fs::read(path).map_err(|e| Error::Io { path: path.to_owned(), source: e })?;
+        let src = utf8(bytes, path)?;
         let dir = path.parent().map(Path::to_owned).unwrap_or_default();
         Scene::from_toml(&src, path, &dir)
     }
@@ -191,6 +247,8 @@ impl Scene {
     /// Parses scene text; `file` names it in errors and `dir` is where relative mesh paths
     /// start from.
     pub fn from_toml(src: &str, file: &Path, dir: &Path) -> Result<Scene> {
+        // A UTF-8 byte-order mark is not part of the first line.
+        let src = src.strip_prefix('\u{feff}').unwrap_or(src);
         let cx = Ctx { file, src };
         let raw: RawScene = toml::from_str(src).map_err(|e| {
             let msg = e.message().trim().replace('\n', " ");
@@ -202,17 +260,32 @@ impl Scene {
 
         let cam_span = raw.camera.span();
         let c = raw.camera.into_inner();
+        let num = |x: &Option<Spanned<Num>>| x.as_ref().map(|x| x.get_ref().0);
         let camera = Camera {
-            eye: v3(c.eye),
+            eye: v3(*c.eye.get_ref()),
             target: v3(c.target),
-            up: c.up.map_or(DVec3::Y, v3),
-            fov_y: c.fov_y.map_or(45.0, |x| x.0),
-            width: c.width.unwrap_or(640),
-            height: c.height.unwrap_or(480),
-            near: c.near.map_or(0.01, |x| x.0),
-            far: c.far.map(|x| x.0),
+            up: c.up.as_ref().map_or(DVec3::Y, |u| v3(*u.get_ref())),
+            fov_y: num(&c.fov_y).unwrap_or(45.0),
+            width: c.width.as_ref().map_or(640, |w| *w.get_ref()),
+            height: c.height.as_ref().map_or(480, |h| *h.get_ref()),
+            near: num(&c.near).unwrap_or(0.01),
+            far: num(&c.far),
         };
-        camera.validate().map_err(|m| cx.err(cam_span, m))?;
+        // A camera error names the line of the key that is wrong.
+        let key_span = |m: &str| {
+            let span = |key: &str| match key {
+                "eye" => Some(c.eye.span()),
+                "up" => c.up.as_ref().map(Spanned::span),
+                "fov_y" => c.fov_y.as_ref().map(Spanned::span),
+                "size" => c.width.as_ref().or(c.height.as_ref()).map(Spanned::span),
+                "near" => c.near.as_ref().map(Spanned::span),
+                "far" => c.far.as_ref().map(Spanned::span),
+                _ => None,
+            };
+            let key = m.strip_prefix("camera ").and_then(|r| r.split_whitespace().next()).unwrap_or("");
+            span(key).unwrap_or(cam_span.clone())
+        };
+        camera.validate().map_err(|m| cx.err(key_span(&m), m))?;
 
         let render = raw.render.map_or_else(RenderSettings::default, |r| RenderSettings {
             ambient: r.ambient.map_or(Vec3::splat(0.1), c3),
@@ -229,27 +302,29 @@ impl Scene {
                 return Err(cx.err(m.name.span(), format!("material '{name}' is defined twice")));
             }
             let d = Material::new(name);
+            // Each ranged key is checked where it is written.
+            let ranged = |v: &Option<Spanned<Num32>>, key: &str, ok: fn(f32) -> bool, rule: &str, default: f32| match v
+            {
+                None => Ok(default),
+                Some(x) if ok(x.get_ref().0) => Ok(x.get_ref().0),
+                Some(x) => Err(cx.err(x.span(), format!("material {key} must be {rule}, got {}", x.get_ref().0))),
+            };
+            let unit = |x: f32| (0.0..=1.0).contains(&x);
             let mat = Material {
                 color: m.color.map_or(d.color, c3),
                 specular_color: m.specular_color.map_or(d.specular_color, c3),
-                ka: m.ka.map_or(d.ka, |x| x.0 as f32),
-                kd: m.kd.map_or(d.kd, |x| x.0 as f32),
-                ks: m.ks.map_or(d.ks, |x| x.0 as f32),
-                shininess: m.shininess.map_or(d.shininess, |x| x.0 as f32),
+                ka: m.ka.map_or(d.ka, |x| x.0),
+                kd: m.kd.map_or(d.kd, |x| x.0),
+                ks: m.ks.map_or(d.ks, |x| x.0),
+                shininess: ranged(&m.shininess, "shininess", |x| x >= 0.0, ">= 0", d.shininess)?,
                 model: m.model.unwrap_or(d.model),
-                roughness: m.roughness.map_or(d.roughness, |x| x.0 as f32),
-                fresnel: m.fresnel.map_or(d.fresnel, |x| x.0 as f32),
-                mirror: m.mirror.map_or(d.mirror, |x| x.0 as f32),
+                roughness: ranged(&m.roughness, "roughness", |x| x > 0.0, "> 0", d.roughness)?,
+                fresnel: ranged(&m.fresnel, "fresnel", unit, "in [0, 1]", d.fresnel)?,
+                mirror: ranged(&m.mirror, "mirror", unit, "in [0, 1]", d.mirror)?,
                 shading: m.shading.unwrap_or(d.shading),
                 ..d
             };
-            if mat.roughness <= 0.0
-                || mat.shininess < 0.0
-                || !(0.0..=1.0).contains(&mat.fresnel)
-                || !(0.0..=1.0).contains(&mat.mirror)
-            {
-                return Err(cx.err(span, "roughness must be > 0, shininess >= 0, fresnel and mirror in [0, 1]"));
-            }
+            let _ = span;
             materials.push(mat);
         }
 
@@ -281,9 +356,10 @@ impl Scene {
                     match meshes.get(&path) {
                         Some(m) => m.clone(),
                         None => {
-                            let text = std::fs::read_to_string(&path).map_err(|e| {
+                            let bytes = std::fs::read(&path).map_err(|e| {
                                 cx.err(rel.span(), format!("cannot read mesh '{}': {e}", path.display()))
                             })?;
+                            let text = utf8(bytes, &path)?;
                             let m = Arc::new(super::parse_obj(&text, &path)?);
                             meshes.insert(path, m.clone());
                             m
@@ -311,6 +387,16 @@ impl Scene {
     }
 }
 
+/// The text of a file, or an error naming the line of its first byte that is not UTF-8.
+fn utf8(bytes: Vec<u8>, path: &Path) -> Result<String> {
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let before = &e.as_bytes()[..at];
+        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+        Error::input(FileLoc::line(path, line), format!("not UTF-8 text (byte {at})"))
+    })
+}
+
 fn light(cx: &Ctx, l: Spanned<RawLight>) -> Result<Light> {
     let span = l.span();
     let l = l.into_inner();
@@ -331,35 +417,58 @@ fn light(cx: &Ctx, l: Spanned<RawLight>) -> Result<Light> {
     refuse((l.cutoff.is_some() || l.exponent.is_some()) && kind != Spot, "cutoff/exponent", "spot")?;
     let area_keys = l.corner.is_some() || l.edge_u.is_some() || l.edge_v.is_some() || l.samples.is_some();
     refuse(area_keys && kind != Area, "corner/edge_u/edge_v/samples", "area")?;
-    let unit = |d: DVec3| {
-        if d.length() == 0.0 {
-            Err(cx.err(span.clone(), "light direction is the zero vector"))
-        } else {
-            Ok(d.normalize())
-        }
+    // Any length of direction: it is scaled before it is normalised, so a huge one does not
+    // overflow.
+    let direction = || {
+        let d = l
+            .direction
+            .as_ref()
+            .ok_or_else(|| cx.err(span.clone(), format!("{kind:?} light needs 'direction'").to_lowercase()))?;
+        crate::geometry::unit(v3(*d.get_ref())).ok_or_else(|| cx.err(d.span(), "light direction is the zero vector"))
+    };
+    // Checked where written: the key's own line.
+    let at = |v: &Option<Spanned<Num>>, default: f64, ok: fn(f64) -> bool, rule: &str, key: &str| match v {
+        None => Ok(default),
+        Some(x) if ok(x.get_ref().0) => Ok(x.get_ref().0),
+        Some(x) => Err(cx.err(x.span(), format!("spot {key} must be {rule}, got {}", x.get_ref().0))),
     };
     let kind = match kind {
         Point => LightKind::Point { position: need(l.position, "position")? },
-        Directional => LightKind::Directional { direction: unit(need(l.direction, "direction")?)? },
+        Directional => LightKind::Directional { direction: direction()? },
         Spot => LightKind::Spot {
             position: need(l.position, "position")?,
-            direction: unit(need(l.direction, "direction")?)?,
-            cutoff: l.cutoff.map_or(45.0, |x| x.0),
-            exponent: l.exponent.map_or(1.0, |x| x.0),
+            direction: direction()?,
+            cutoff: at(&l.cutoff, 45.0, |c| c > 0.0 && c <= 180.0, "in (0, 180] degrees", "cutoff")?,
+            exponent: at(&l.exponent, 1.0, |e| e >= 0.0, ">= 0", "exponent")?,
         },
         Area => LightKind::Area {
             corner: need(l.corner, "corner")?,
             edge_u: need(l.edge_u, "edge_u")?,
             edge_v: need(l.edge_v, "edge_v")?,
-            samples: l.samples.ok_or_else(|| cx.err(span.clone(), "area light needs 'samples'"))?,
+            samples: l
+                .samples
+                .as_ref()
+                .map(|s| s.get_ref().0)
+                .ok_or_else(|| cx.err(span.clone(), "area light needs 'samples'"))?,
         },
     };
     let light = Light {
         kind,
         color: l.color.map_or(Vec3::ONE, c3),
-        intensity: l.intensity.map_or(1.0, |x| x.0 as f32),
-        attenuation: l.attenuation.map_or([1.0, 0.0, 0.0], |a| v3(a).to_array()),
+        intensity: l.intensity.map_or(1.0, |x| x.0),
+        attenuation: l.attenuation.as_ref().map_or([1.0, 0.0, 0.0], |a| v3(*a.get_ref()).to_array()),
     };
-    light.validate().map_err(|m| cx.err(span, m))?;
+    // What is left to check names the key whose value is wrong.
+    let key_span = |m: &str| {
+        let spanned = if m.starts_with("attenuation") {
+            l.attenuation.as_ref().map(Spanned::span)
+        } else if m.starts_with("area light samples") {
+            l.samples.as_ref().map(Spanned::span)
+        } else {
+            None
+        };
+        spanned.unwrap_or(span.clone())
+    };
+    light.validate().map_err(|m| cx.err(key_span(&m), m))?;
     Ok(light)
 }

@@ -41,21 +41,34 @@ impl Camera {
         Camera { eye, target, up: DVec3::Y, fov_y: 45.0, width: 640, height: 480, near: 0.01, far: None }
     }
 
-    fn validate(&self) -> std::result::Result<(), String> {
-        let f = self.target - self.eye;
-        if f.length() == 0.0 {
-            return Err("camera eye and target are the same point".into());
+    /// The narrowest field of view accepted, in degrees: narrower, the projection's scale
+    /// (`1 / tan(fov_y / 2)`) loses the precision the scan converter needs.
+    pub const MIN_FOV_Y: f64 = 1e-4;
+
+    pub(crate) fn validate(&self) -> std::result::Result<(), String> {
+        if !(self.eye.is_finite() && self.target.is_finite() && self.up.is_finite()) {
+            return Err("camera eye, target and up must be finite".into());
         }
-        if f.normalize().cross(self.up).length() < 1e-9 {
+        let Some(f) = crate::geometry::unit(self.target - self.eye) else {
+            return Err("camera eye and target are the same point (or too far apart for f64)".into());
+        };
+        let Some(up) = crate::geometry::unit(self.up) else {
+            return Err("camera up is the zero vector".into());
+        };
+        if f.cross(up).length() < 1e-9 {
             return Err("camera up is parallel to the view direction".into());
         }
-        if !(self.fov_y > 0.0 && self.fov_y < 180.0) {
-            return Err(format!("camera fov_y must be in (0, 180) degrees, got {}", self.fov_y));
+        if !(self.fov_y >= Self::MIN_FOV_Y && self.fov_y < 180.0) {
+            return Err(format!(
+                "camera fov_y must be in [{}, 180) degrees, got {}",
+                Self::MIN_FOV_Y,
+                crate::error::num(self.fov_y)
+            ));
         }
         if self.width == 0 || self.height == 0 || self.width > 32768 || self.height > 32768 {
             return Err(format!("camera size {}x{} must be 1..=32768 each way", self.width, self.height));
         }
-        if self.near <= 0.0 {
+        if !(self.near > 0.0 && self.near.is_finite()) {
             return Err(format!("camera near must be > 0, got {}", self.near));
         }
         if let Some(far) = self.far {
@@ -463,16 +476,20 @@ impl Scene {
             normals: Vec::new(),
             face_count: 0,
         };
-        scene.compile();
+        scene.compile().map_err(Error::Invalid)?;
         Ok(scene)
     }
 
-    fn compile(&mut self) {
+    fn compile(&mut self) -> std::result::Result<(), String> {
         for (oi, obj) in self.objects.iter().enumerate() {
             let m = obj.transform.matrix();
             let nm = DMat3::from_mat4(m).inverse().transpose();
             let mesh = &obj.mesh;
             let world: Vec<DVec3> = mesh.positions.iter().map(|&p| m.transform_point3(p)).collect();
+            if !world.iter().all(|p| p.is_finite()) {
+                let name = obj.name.as_deref().map_or(String::new(), |n| format!(" '{n}'"));
+                return Err(format!("object {oi}{name}: its transform takes vertices beyond the range of f64"));
+            }
             let vn: Vec<DVec3> = mesh.normals.iter().map(|&n| (nm * n).normalize_or_zero()).collect();
             // Averaged normals for faces without `vn`: area-weighted face normals summed over
             // every face that shares the vertex's position (meshes often repeat a position
@@ -526,6 +543,7 @@ impl Scene {
             }
             self.face_count += mesh.faces.len() as u32;
         }
+        Ok(())
     }
 
     /// The vertices of polygon `i`.

@@ -12,6 +12,8 @@ use std::path::Path;
 
 /// Parses OBJ text; `file` names it in errors.
 pub fn parse_obj(text: &str, file: &Path) -> Result<Mesh> {
+    // A UTF-8 byte-order mark is not part of the first line.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut mesh = Mesh::default();
     let mut texcoords = 0usize;
     for (n, raw) in text.lines().enumerate() {
@@ -81,9 +83,15 @@ fn vec3<'a>(words: &mut impl Iterator<Item = &'a str>, what: &str, loc: &impl Fn
         let w = words.next().ok_or_else(|| Error::input(loc(), format!("'{what}' needs three numbers")))?;
         *x = number(w, what, loc)?;
     }
-    // An optional fourth (w) component is allowed for `v` and ignored.
+    // An optional fourth (w) component is allowed for `v` (OBJ's weight) and ignored.
     if let Some(w) = words.next() {
+        if what != "v" {
+            return Err(Error::input(loc(), format!("'{what}' takes three numbers, found a fourth '{w}'")));
+        }
         number(w, what, loc)?;
+    }
+    if let Some(extra) = words.next() {
+        return Err(Error::input(loc(), format!("'{what}' takes at most four numbers, found '{extra}'")));
     }
     Ok(DVec3::from_array(c))
 }

@@ -262,7 +262,7 @@ fn unshadowed(o: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Resul
 }
 
 fn clip_error(e: ClipError) -> Error {
-    Error::Invalid(format!("atherton-weiler-greenberg: {e}"))
+    Error::Internal(format!("atherton-weiler-greenberg: {e}"))
 }
 
 /// One view from the light: how world points map into its 2D coordinates.

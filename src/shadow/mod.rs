@@ -213,8 +213,8 @@ impl ShadowMethod {
             ShadowMethod::BouknightKelley => Box::new(BouknightKelley::new(ctx, counters)),
             ShadowMethod::Crow => Box::new(Crow::new(ctx, counters)),
             ShadowMethod::AthertonWeilerGreenberg => Box::new(AthertonWeilerGreenberg::new(ctx, counters)?),
-            ShadowMethod::Williams => Box::new(Williams::new(ctx, counters)),
-            ShadowMethod::StencilVolume => Box::new(StencilVolume::new(ctx, counters)),
+            ShadowMethod::Williams => Box::new(Williams::new(ctx, counters)?),
+            ShadowMethod::StencilVolume => Box::new(StencilVolume::new(ctx, counters)?),
             ShadowMethod::Planar => Box::new(Planar::new(ctx, counters)?),
         })
     }

@@ -76,7 +76,7 @@ impl<'a> Planar<'a> {
         let receivers: Vec<usize> =
             (0..scene.polygons.len()).filter(|&i| scene.objects[scene.polygons[i].object as usize].receiver).collect();
         if receivers.is_empty() {
-            return Err(Error::Invalid(
+            return Err(Error::NotApplicable(
                 "planar shadows need a receiver: mark the ground's object with receiver = true".into(),
             ));
         }

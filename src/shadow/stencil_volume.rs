@@ -22,9 +22,14 @@ pub struct StencilVolume<'a> {
 
 impl<'a> StencilVolume<'a> {
     /// Rasterises every light sample's shadow polygons into a stencil count.
-    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
+    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> crate::Result<Self> {
         let view = ctx.view;
         let (w, h) = (view.width as usize, view.height);
+        let pixels = w as u64 * h as u64;
+        let samples = ctx.all_samples().count() as u64;
+        // A lit mask per sample, the stencil counts and the surface ids.
+        let bytes = crate::budget::mul(samples, pixels).saturating_add(8 * pixels);
+        crate::budget::check(format_args!("stencil-volume: {samples} lit mask(s) of {w}x{h}"), bytes)?;
         let scene = ctx.scene;
         // The depth buffer of the visible surfaces, from the visibility stage's runs.
         let mut surface = vec![u32::MAX; w * h as usize];
@@ -74,7 +79,7 @@ impl<'a> StencilVolume<'a> {
             })
             .collect();
         counters.add("stencil_writes", writes);
-        StencilVolume { ctx, lit }
+        Ok(StencilVolume { ctx, lit })
     }
 }
 

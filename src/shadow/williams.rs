@@ -78,8 +78,8 @@ impl WilliamsOptions {
     pub const MAX_KERNEL: u32 = 63;
 
     /// Checks that the options can be carried out: a map side of 1 to
-    /// [`Self::MAX_MAP_SIZE`] texels, an odd kernel side of 1 to [`Self::MAX_KERNEL`], and
-    /// biases that are finite and not negative.
+    /// [`Self::MAX_MAP_SIZE`] texels, an odd kernel side of 1 to [`Self::MAX_KERNEL`] and no
+    /// wider than the map, and biases that are finite and not negative.
     pub fn check(&self) -> Result<()> {
         let fail = |what: String| Err(Error::Invalid(format!("williams: {what}")));
         if !(1..=Self::MAX_MAP_SIZE).contains(&self.map_size) {
@@ -88,6 +88,9 @@ impl WilliamsOptions {
         if let ShadowFilter::Pcf(n) | ShadowFilter::SoftEdge(n) = self.filter {
             if n.is_multiple_of(2) || n > Self::MAX_KERNEL {
                 return fail(format!("kernel size {n} is not odd and in 1..={}", Self::MAX_KERNEL));
+            }
+            if n > self.map_size {
+                return fail(format!("kernel size {n} is wider than the {0}x{0} map", self.map_size));
             }
         }
         for (name, v) in [("bias", self.bias.unwrap_or(0.0)), ("slope bias", self.slope_bias)] {
@@ -560,8 +563,10 @@ pub struct Williams<'a> {
 
 impl<'a> Williams<'a> {
     /// Pass 1 for every light sample (and, for the soft-edge filter, the screen buffers).
-    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
+    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Result<Self> {
         let options = ctx.options.williams.clone();
+        options.check()?;
+        Self::check_memory(ctx, &options)?;
         let bias = options.bias.unwrap_or(1e-3 * ctx.extent);
         let samples: Vec<_> = ctx.all_samples().collect();
         let maps = samples.iter().map(|&(_, _, s)| LightMaps::new(ctx, s, &options, counters)).collect();
@@ -575,7 +580,28 @@ impl<'a> Williams<'a> {
         if let ShadowFilter::SoftEdge(_) = stage.options.filter {
             stage.blurred = samples.iter().map(|&(l, s, _)| stage.soft_edge_buffer(l, s)).collect();
         }
-        stage
+        Ok(stage)
+    }
+
+    /// Refuses options whose maps (every light sample's, up to six for a point light's cube)
+    /// and soft-edge buffers would not fit [`crate::budget::MEMORY_BUDGET`].
+    fn check_memory(ctx: &ShadowContext, o: &WilliamsOptions) -> Result<()> {
+        use crate::budget::mul;
+        let pad = o.map_size as u64 + PAD as u64;
+        let per_map = mul(pad, pad + 2) * 4;
+        let maps: u64 = ctx
+            .all_samples()
+            .map(|(_, _, s)| match s {
+                LightSample::Point(_) => 6,
+                LightSample::Directional(_) => 1,
+            })
+            .sum();
+        let mut bytes = mul(maps, per_map);
+        if let ShadowFilter::SoftEdge(_) = o.filter {
+            let screen = ctx.view.width as u64 * ctx.view.height as u64 * 4;
+            bytes = bytes.saturating_add(mul(ctx.all_samples().count() as u64, screen));
+        }
+        crate::budget::check(format_args!("williams: {maps} shadow map(s) of {0}x{0} texels", o.map_size), bytes)
     }
 
     /// The radius of the filter's kernel, in texels.

@@ -140,7 +140,7 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
     std::fs::create_dir_all(&img_dir).map_err(|e| Error::Io { path: img_dir.clone(), source: e })?;
     let save = |img: image::RgbImage, file: &str| -> Result<String> {
         let path = img_dir.join(file);
-        img.save_with_format(&path, image::ImageFormat::Png).map_err(|e| Error::Image { path, source: e })?;
+        crate::frame::write_png(img.into(), &path)?;
         Ok(format!("img/{file}"))
     };
     let reference_opts = RenderOptions {
@@ -172,8 +172,12 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
             for _ in 0..opts.runs.max(1) {
                 match render(scene, &ropts) {
                     Ok(r) => runs.push(r),
-                    Err(Error::Invalid(why)) => {
+                    Err(Error::NotApplicable(why)) => {
                         status = format!("not applicable: {why}");
+                        break;
+                    }
+                    Err(e @ Error::Internal(_)) => {
+                        status = format!("failed: {e}");
                         break;
                     }
                     Err(e) => return Err(e),
@@ -247,7 +251,7 @@ fn escape(s: &str) -> String {
 }
 
 fn write_files(report: &Report, out: &Path) -> Result<()> {
-    let json = serde_json::to_string_pretty(report).map_err(|e| Error::Invalid(e.to_string()))?;
+    let json = serde_json::to_string_pretty(report).map_err(|e| Error::Internal(e.to_string()))?;
     write(&out.join("results.json"), &json)?;
     let mut csv = String::from("visibility,shadows,status,exact,time_ms,interior_pixels,wrong_pixels,error_share\n");
     for r in &report.results {
