@@ -33,6 +33,7 @@ use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -354,63 +355,91 @@ impl LightView {
     }
 }
 
+/// Steps 1(a)-(c) and 2 for one view of one light sample: the scene mapped into the view,
+/// the casters sorted, the lit fragments of every polygon taken back into world space.
+fn lit_in_view(
+    scene: &Scene,
+    sample: LightSample,
+    view: LightView,
+    extent: f64,
+    stats: &mut Pass1,
+) -> std::result::Result<Vec<DetailPolygon>, ClipError> {
+    let (mut casters, mut others) = (Vec::new(), Vec::new());
+    for (i, poly) in scene.polygons.iter().enumerate() {
+        if edge_on(scene, i, sample, extent) {
+            continue;
+        }
+        let Some((ring, near)) = view.map(scene.verts(i), &poly.plane, 1e-9 * extent) else { continue };
+        let Some(piece) = Piece::new(i as u32, Region::from_ring(ring), near) else { continue };
+        if scene.casts_shadows(i) {
+            casters.push(piece);
+        } else {
+            others.push(piece);
+        }
+    }
+    let seen = visible(casters.clone(), 0, stats)?;
+    // The pieces of a face split into a fan never shadow each other: their lit parts come
+    // from a sort without their sibling pieces.
+    let face = |p: &Piece| scene.polygons[p.source as usize].face;
+    let mut pieces_of: HashMap<u32, usize> = HashMap::new();
+    for c in &casters {
+        *pieces_of.entry(face(c)).or_default() += 1;
+    }
+    let split = |p: &Piece| pieces_of.get(&face(p)).is_some_and(|&n| n > 1);
+    let mut pieces: Vec<Piece> = seen.iter().filter(|p| !split(p)).cloned().collect();
+    for p in casters.iter().filter(|p| split(p)) {
+        let list =
+            casters.iter().filter(|q| q.source == p.source || (face(q) != face(p) && q.overlaps(p))).cloned().collect();
+        let own = visible(list, 0, stats)?;
+        pieces.extend(own.into_iter().filter(|v| v.source == p.source));
+    }
+    // Polygons that cast no shadow: lit where no visible caster lies in front.
+    for o in others {
+        let lit = unshadowed(o.clone(), &seen, stats)?;
+        pieces.extend(Piece::new(o.source, lit, o.near));
+    }
+    Ok(pieces
+        .into_iter()
+        .map(|p| {
+            let plane = scene.polygons[p.source as usize].plane;
+            let rings = p.region.rings.iter().map(|r| r.iter().map(|&q| view.unmap(q, &plane)).collect()).collect();
+            DetailPolygon { source: p.source, rings }
+        })
+        .collect())
+}
+
 impl ShadowDatabase {
     /// Pass 1 and the merge for light `light` of `scene`: every sample's lit detail polygons.
+    /// The light's views (every sample's, and a point sample's six cube faces) are
+    /// independent, and are sorted in parallel.
     pub fn build(scene: &Scene, light: usize, counters: &mut Counters) -> Result<ShadowDatabase> {
-        let l = scene.lights.get(light).ok_or_else(|| Error::Invalid(format!("no light {light}")))?;
+        let l = scene.lights.get(light).ok_or_else(|| {
+            Error::Invalid(format!("no light {light}: the scene has {} light(s), numbered from 0", scene.lights.len()))
+        })?;
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
         let t = Instant::now();
+        let views: Vec<(usize, LightSample, LightView)> = l
+            .samples()
+            .into_iter()
+            .enumerate()
+            .flat_map(|(s, sample)| LightView::views(sample).into_iter().map(move |v| (s, sample, v)))
+            .collect();
+        let done: Vec<(usize, Vec<DetailPolygon>, Pass1)> = views
+            .into_par_iter()
+            .map(|(s, sample, view)| {
+                let mut stats = Pass1::default();
+                let lit = lit_in_view(scene, sample, view, extent, &mut stats).map_err(clip_error)?;
+                Ok((s, lit, stats))
+            })
+            .collect::<Result<_>>()?;
+        let mut samples = vec![Vec::new(); l.sample_count()];
         let mut stats = Pass1::default();
-        let mut samples = Vec::new();
-        for sample in l.samples() {
-            let mut lit: Vec<DetailPolygon> = Vec::new();
-            for view in LightView::views(sample) {
-                let mut casters = Vec::new();
-                let mut others = Vec::new();
-                for (i, poly) in scene.polygons.iter().enumerate() {
-                    if edge_on(scene, i, sample, extent) {
-                        continue;
-                    }
-                    let Some((ring, near)) = view.map(scene.verts(i), &poly.plane, 1e-9 * extent) else { continue };
-                    let Some(piece) = Piece::new(i as u32, Region::from_ring(ring), near) else { continue };
-                    if scene.casts_shadows(i) {
-                        casters.push(piece);
-                    } else {
-                        others.push(piece);
-                    }
-                }
-                let seen = visible(casters.clone(), 0, &mut stats).map_err(clip_error)?;
-                // The pieces of a face split into a fan never shadow each other: their lit
-                // parts come from a sort without their sibling pieces.
-                let face = |p: &Piece| scene.polygons[p.source as usize].face;
-                let mut pieces_of: HashMap<u32, usize> = HashMap::new();
-                for c in &casters {
-                    *pieces_of.entry(face(c)).or_default() += 1;
-                }
-                let split = |p: &Piece| pieces_of.get(&face(p)).is_some_and(|&n| n > 1);
-                let mut pieces: Vec<Piece> = seen.iter().filter(|p| !split(p)).cloned().collect();
-                for p in casters.iter().filter(|p| split(p)) {
-                    let list = casters
-                        .iter()
-                        .filter(|q| q.source == p.source || (face(q) != face(p) && q.overlaps(p)))
-                        .cloned()
-                        .collect();
-                    let own = visible(list, 0, &mut stats).map_err(clip_error)?;
-                    pieces.extend(own.into_iter().filter(|v| v.source == p.source));
-                }
-                // Polygons that cast no shadow: lit where no visible caster lies in front.
-                for o in others {
-                    let lit = unshadowed(o.clone(), &seen, &mut stats).map_err(clip_error)?;
-                    pieces.extend(Piece::new(o.source, lit, o.near));
-                }
-                for p in pieces {
-                    let plane = scene.polygons[p.source as usize].plane;
-                    let rings =
-                        p.region.rings.iter().map(|r| r.iter().map(|&q| view.unmap(q, &plane)).collect()).collect();
-                    lit.push(DetailPolygon { source: p.source, rings });
-                }
-            }
-            samples.push(lit);
+        for (s, lit, st) in done {
+            samples[s].extend(lit);
+            stats.fragments += st.fragments;
+            stats.clips += st.clips;
+            stats.splits += st.splits;
+            stats.depth_max = stats.depth_max.max(st.depth_max);
         }
         counters.add("light_space_fragments", stats.fragments);
         counters.add("clip_operations", stats.clips);
