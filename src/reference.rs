@@ -2,12 +2,17 @@
 //! directly (one ray for the visible surface, one shadow ray per light sample), and the
 //! definition of a *tie* that the exactness tests use.
 //!
-//! A pixel is a **tie** when the answer at its centre (the face seen, and each light's lit
-//! fraction) is not the answer at every point within [`TIE_DELTA`] of a pixel around it
-//! (the eight points at `±TIE_DELTA` in x, y or both): the centre then lies, to within
-//! floating-point rounding, on a polygon's edge, on a shadow's edge, or on two coincident
-//! surfaces, where the contract lets either answer stand. Every other pixel has one right
-//! answer, and an exact stage must give it.
+//! A pixel is a **tie** when
+//!
+//! - the answer at its centre (the face seen, and each light's lit fraction) is not the
+//!   answer at every point within [`TIE_DELTA`] of a pixel around it (the eight points at
+//!   `±TIE_DELTA` in x, y or both): the centre then lies, to within floating-point rounding,
+//!   on a polygon's edge, on a shadow's edge, or on two coincident surfaces; or
+//! - a light sample lies in the plane of the polygon it sees (within [`PLANE_TIE`] of the
+//!   scene's size), where the scene format's same-side rule has no sign to go by.
+//!
+//! The contract lets either answer stand at a tie. Every other pixel has one right answer,
+//! and an exact stage must give it.
 
 use crate::bvh::Bvh;
 use crate::scene::{LightSample, Scene};
@@ -15,6 +20,19 @@ use crate::view::View;
 
 /// How far (in pixels) a sample point moves to test for a tie.
 pub const TIE_DELTA: f64 = 1e-6;
+
+/// How close (relative to the scene's size) a light sample must be to the plane of the
+/// polygon a pixel sees for the pixel to be a tie.
+pub const PLANE_TIE: f64 = 1e-9;
+
+/// The two kinds of tie.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tie {
+    /// The answer changes within [`TIE_DELTA`] of a pixel of the centre: an edge.
+    Edge,
+    /// A light sample lies in the plane of the polygon seen.
+    LightInPlane,
+}
 
 /// What a point of the image plane sees.
 #[derive(Debug, Clone, PartialEq)]
@@ -101,11 +119,34 @@ impl<'a> Reference<'a> {
 
     /// Whether pixel `(px, py)` is a tie (see the module's definition).
     pub fn is_tie(&self, px: u32, py: u32) -> bool {
+        self.tie(px, py).is_some()
+    }
+
+    /// Which kind of tie pixel `(px, py)` is, if it is one.
+    pub fn tie(&self, px: u32, py: u32) -> Option<Tie> {
         let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
+        if self.light_in_seen_plane(x, y) {
+            return Some(Tie::LightInPlane);
+        }
         let centre = self.at(x, y);
         let t = TIE_DELTA;
         [(-t, -t), (0.0, -t), (t, -t), (-t, 0.0), (t, 0.0), (-t, t), (0.0, t), (t, t)]
             .iter()
             .any(|&(dx, dy)| self.at(x + dx, y + dy) != centre)
+            .then_some(Tie::Edge)
+    }
+
+    /// Whether a light sample lies in the plane of the polygon seen at `(x, y)`.
+    fn light_in_seen_plane(&self, x: f64, y: f64) -> bool {
+        let d = self.view.ray(x, y);
+        let far = self.view.far.unwrap_or(f64::INFINITY);
+        let Some((poly, _)) = self.all.closest(self.scene, self.view.eye, d, self.view.near, far) else {
+            return false;
+        };
+        let plane = &self.scene.polygons[poly as usize].plane;
+        self.samples.iter().flatten().any(|s| match *s {
+            LightSample::Point(l) => plane.distance(l).abs() <= PLANE_TIE * self.extent,
+            LightSample::Directional(dir) => plane.n.dot(dir).abs() <= PLANE_TIE,
+        })
     }
 }

@@ -194,3 +194,160 @@ fn one_shadow_database_serves_many_views() {
         );
     }
 }
+
+/// Random closed meshes (boxes, prisms, spheres; from TOML and from OBJ; wound either way)
+/// with the light inside, on a vertex, on an edge, in a face's plane or outside, the eye
+/// sometimes inside too, and a self-intersecting polygon (a pentagram or a bow-tie) over the
+/// floor: every exact stage equals ray-cast at every pixel but ties.
+#[test]
+fn random_solids_with_lights_inside_on_and_around() {
+    use rand::{Rng, SeedableRng};
+    let dir = std::env::temp_dir().join(format!("umbra-solids-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut in_shadow = 0;
+    for seed in 0..120u64 {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let solid = solid(seed % 3, &mut rng);
+        let inward = rng.gen_bool(0.5);
+        let faces: Vec<Vec<[f64; 3]>> =
+            solid.faces.iter().map(|f| if inward { f.iter().rev().copied().collect() } else { f.clone() }).collect();
+        // Where the light goes.
+        let centre = solid.centre;
+        let light = match seed % 5 {
+            0 => centre,                                              // inside
+            1 => faces[0][0],                                         // on a vertex
+            2 => mid(faces[0][0], faces[0][1]),                       // on an edge
+            3 => along(centroid(&faces[0]), faces[0][2], 1.6),        // in one face's plane, beyond a vertex
+            _ => [centre[0] + 0.4, centre[1] + 3.0, centre[2] + 0.3], // outside, above
+        };
+        let eye = if seed % 7 == 0 { [centre[0] + 0.05, centre[1] + 0.02, centre[2] + 0.03] } else { [0.5, 3.0, 6.5] };
+        let star = star_polygon(&mut rng);
+        let mesh = if seed % 2 == 0 {
+            let obj = dir.join(format!("solid{seed}.obj"));
+            let mut text = String::new();
+            for f in &faces {
+                for v in f {
+                    text += &format!("v {} {} {}\n", v[0], v[1], v[2]);
+                }
+            }
+            let mut next = 1;
+            for f in &faces {
+                let ids: Vec<String> = (next..next + f.len()).map(|i| i.to_string()).collect();
+                text += &format!("f {}\n", ids.join(" "));
+                next += f.len();
+            }
+            std::fs::write(&obj, text).unwrap();
+            format!("mesh = \"{}\"\n", obj.display())
+        } else {
+            format!("polygons = [{}]\n", faces.iter().map(|f| poly(f)).collect::<Vec<_>>().join(", "))
+        };
+        let src = format!(
+            "[camera]\neye = {}\ntarget = {}\nwidth = 64\nheight = 48\nnear = 0.01\n\
+             [[light]]\nkind = \"point\"\nposition = {}\n\
+             [[object]]\npolygons = [[[-5.0,0.0,-5.0],[-5.0,0.0,5.0],[5.0,0.0,5.0],[5.0,0.0,-5.0]]]\n\
+             [[object]]\n{mesh}\
+             [[object]]\npolygons = [{}]\n",
+            v3(eye),
+            v3(centre),
+            v3(light),
+            poly(&star)
+        );
+        let scene = Scene::from_toml(&src, std::path::Path::new("solid.toml"), &dir).unwrap_or_else(|e| panic!("{e}"));
+        let (_, s) = check(&scene, &format!("solid seed {seed}"));
+        in_shadow += s;
+    }
+    assert!(in_shadow > 120 * 200, "only {in_shadow} pixels in shadow");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+struct Solid {
+    faces: Vec<Vec<[f64; 3]>>,
+    centre: [f64; 3],
+}
+
+/// A closed, outward-wound box, hexagonal prism or sphere of random size and place.
+fn solid(kind: u64, rng: &mut impl rand::Rng) -> Solid {
+    let c = [rng.gen_range(-1.0..1.0), rng.gen_range(0.8..1.5), rng.gen_range(-1.0..1.0)];
+    let r = rng.gen_range(0.4..0.8);
+    let ring = |n: usize, y: f64, rr: f64, phase: f64| -> Vec<[f64; 3]> {
+        (0..n)
+            .map(|k| {
+                let a = phase + std::f64::consts::TAU * k as f64 / n as f64;
+                [c[0] + rr * a.cos(), y, c[2] + rr * a.sin()]
+            })
+            .collect()
+    };
+    let mut faces = Vec::new();
+    match kind {
+        0 | 1 => {
+            // A box is a prism over a square.
+            let n = if kind == 0 { 4 } else { 6 };
+            let (lo, hi) = (ring(n, c[1] - r, r, 0.3), ring(n, c[1] + r, r, 0.3));
+            faces.push(lo.clone()); // seen from below: counter-clockwise about -y
+            faces.push(hi.iter().rev().copied().collect());
+            for k in 0..n {
+                let j = (k + 1) % n;
+                faces.push(vec![lo[k], hi[k], hi[j], lo[j]]);
+            }
+        }
+        _ => {
+            let (stacks, slices) = (5, 8);
+            let at = |i: usize, k: usize| {
+                let t = std::f64::consts::PI * i as f64 / stacks as f64;
+                let a = std::f64::consts::TAU * k as f64 / slices as f64;
+                [c[0] + r * t.sin() * a.cos(), c[1] + r * t.cos(), c[2] + r * t.sin() * a.sin()]
+            };
+            for i in 0..stacks {
+                for k in 0..slices {
+                    let j = (k + 1) % slices;
+                    let quad = [at(i, k), at(i, j), at(i + 1, j), at(i + 1, k)];
+                    let mut f: Vec<[f64; 3]> = quad.to_vec();
+                    f.dedup();
+                    if f.first() == f.last() {
+                        f.pop();
+                    }
+                    faces.push(f);
+                }
+            }
+        }
+    }
+    Solid { faces, centre: c }
+}
+
+/// A self-intersecting polygon over the floor: a pentagram or a bow-tie.
+fn star_polygon(rng: &mut impl rand::Rng) -> Vec<[f64; 3]> {
+    let (x, y, z) = (rng.gen_range(-1.5..1.5), rng.gen_range(0.3..2.5), rng.gen_range(-1.5..1.5));
+    let r = rng.gen_range(0.4..1.0);
+    if rng.gen_bool(0.5) {
+        (0..5)
+            .map(|k| {
+                let a = std::f64::consts::TAU * (2 * k) as f64 / 5.0;
+                [x + r * a.cos(), y, z + r * a.sin()]
+            })
+            .collect()
+    } else {
+        vec![[x - r, y, z - r], [x + r, y, z + r], [x + r, y, z - r], [x - r, y, z + r]]
+    }
+}
+
+fn centroid(f: &[[f64; 3]]) -> [f64; 3] {
+    let n = f.len() as f64;
+    let sum = f.iter().fold([0.0; 3], |s, v| [s[0] + v[0], s[1] + v[1], s[2] + v[2]]);
+    [sum[0] / n, sum[1] / n, sum[2] / n]
+}
+
+fn mid(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    along(a, b, 0.5)
+}
+
+fn along(a: [f64; 3], b: [f64; 3], t: f64) -> [f64; 3] {
+    [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t]
+}
+
+fn v3(v: [f64; 3]) -> String {
+    format!("[{:?}, {:?}, {:?}]", v[0], v[1], v[2])
+}
+
+fn poly(f: &[[f64; 3]]) -> String {
+    format!("[{}]", f.iter().map(|&v| v3(v)).collect::<Vec<_>>().join(", "))
+}

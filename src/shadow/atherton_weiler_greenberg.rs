@@ -28,7 +28,7 @@ use super::projection::edge_on;
 use super::{ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::weiler_atherton::{clip, ClipError, Region};
-use crate::geometry::{clip_polygon, Plane};
+use crate::geometry::{clip_polygon, even_odd, Plane};
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -355,6 +355,24 @@ impl LightView {
     }
 }
 
+/// A polygon's region for the clipper, whose rings must not cross themselves: a
+/// self-intersecting outline (inside by the even-odd rule) becomes the trapezoids of its
+/// even-odd region ([`crate::geometry::even_odd`]), which touch but never cross.
+fn even_odd_region(ring: Vec<DVec2>) -> Region {
+    if !even_odd::self_intersects(&ring) {
+        return Region::from_ring(ring);
+    }
+    let rings = even_odd::trapezoids(&ring)
+        .into_iter()
+        .filter_map(|t| {
+            let mut r = t.to_vec();
+            r.dedup();
+            (r.len() >= 3).then_some(r)
+        })
+        .collect();
+    Region { rings }
+}
+
 /// Steps 1(a)-(c) and 2 for one view of one light sample: the scene mapped into the view,
 /// the casters sorted, the lit fragments of every polygon taken back into world space.
 fn lit_in_view(
@@ -370,7 +388,7 @@ fn lit_in_view(
             continue;
         }
         let Some((ring, near)) = view.map(scene.verts(i), &poly.plane, 1e-9 * extent) else { continue };
-        let Some(piece) = Piece::new(i as u32, Region::from_ring(ring), near) else { continue };
+        let Some(piece) = Piece::new(i as u32, even_odd_region(ring), near) else { continue };
         if scene.casts_shadows(i) {
             casters.push(piece);
         } else {

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use std::path::PathBuf;
-use umbra::reference::Reference;
+use umbra::reference::{Reference, Tie};
 use umbra::shadow::ShadowOptions;
 use umbra::{render, Frame, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
@@ -74,9 +74,10 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod, ShadowOptions)> {
 /// Compares `got` with `reference` at every pixel by `differs(k)`; a pixel that differs is
 /// excused only when it is a tie by [`umbra::reference`]'s definition (the exact answer
 /// changes within 1e-6 of a pixel of its centre). Panics with the first few pixels that
-/// differ and are not ties, or when ties are more than 1% of the pixels (a tie is a pixel
-/// centre exactly on an edge; that many means something else is wrong). Returns the pixels
-/// compared and the ties excused.
+/// differ and are not ties, or when edge ties are more than 1% of the pixels (an edge tie is
+/// a pixel centre exactly on an edge; that many means something else is wrong; a light in
+/// the plane of the surface seen can make a whole face a tie). Returns the pixels compared
+/// and the ties excused.
 fn assert_agree<T: std::fmt::Debug>(
     scene: &Scene,
     reference: &Frame,
@@ -85,17 +86,19 @@ fn assert_agree<T: std::fmt::Debug>(
     differs: impl Fn(u32, u32, usize) -> Vec<T>,
 ) -> Agreement {
     let oracle = std::cell::OnceCell::new();
-    let (mut ties, mut bad) = (0, Vec::new());
+    let (mut ties, mut edge_ties, mut bad) = (0, 0, Vec::new());
     for y in 0..reference.height {
         for x in 0..reference.width {
             let found = differs(x, y, (y * reference.width + x) as usize);
             if found.is_empty() {
                 continue;
             }
-            if oracle.get_or_init(|| Reference::new(scene)).is_tie(x, y) {
-                ties += 1;
-            } else {
-                bad.extend(found);
+            match oracle.get_or_init(|| Reference::new(scene)).tie(x, y) {
+                Some(kind) => {
+                    ties += 1;
+                    edge_ties += usize::from(kind == Tie::Edge);
+                }
+                None => bad.extend(found),
             }
         }
     }
@@ -106,7 +109,7 @@ fn assert_agree<T: std::fmt::Debug>(
         bad.len(),
         &bad[..bad.len().min(10)]
     );
-    assert!(ties * 100 <= compared, "{label}: {ties} of {compared} pixels differ at ties");
+    assert!(edge_ties * 100 <= compared, "{label}: {edge_ties} of {compared} pixels differ at edge ties");
     Agreement { compared, ties }
 }
 
