@@ -26,12 +26,16 @@ impl FileLoc {
         FileLoc { file: file.into(), line: Some(line), column: None }
     }
 
-    /// The place of byte `offset` in `source`, the text of `file`.
+    /// The place of byte `offset` in `source`, the text of `file`. Lines end at `\n`,
+    /// `\r\n`, or a lone `\r` (old Mac files), as an editor counts them.
     pub fn at_offset(file: impl Into<PathBuf>, source: &str, offset: usize) -> Self {
         let offset = offset.min(source.len());
-        let before = &source.as_bytes()[..offset];
-        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-        let column = offset - before.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1) + 1;
+        let bytes = source.as_bytes();
+        let before = &bytes[..offset];
+        // A line ends after a '\n', or after a '\r' that no '\n' follows.
+        let ends_line = |i: usize| bytes[i] == b'\n' || (bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n'));
+        let line = (0..offset).filter(|&i| ends_line(i)).count() + 1;
+        let column = offset - (0..before.len()).rev().find(|&i| ends_line(i)).map_or(0, |p| p + 1) + 1;
         FileLoc { file: file.into(), line: Some(line), column: Some(column) }
     }
 }

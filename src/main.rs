@@ -391,6 +391,14 @@ fn run(cli: Cli) -> umbra::Result<()> {
         }
         Command::ExportShadows(e) => {
             let scene = Scene::load(&e.scene)?;
+            if e.light >= scene.lights.len() {
+                return Err(Error::Invalid(format!(
+                    "{}: no light {} (the scene has {} light(s), numbered from 0)",
+                    e.scene.display(),
+                    e.light,
+                    scene.lights.len()
+                )));
+            }
             let mut counters = umbra::Counters::default();
             let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, &mut counters)?;
             db.write_obj(&scene, &e.output)

@@ -259,10 +259,12 @@ pub fn reference_mirror_ids(scene: &Scene) -> Vec<u32> {
             let n = poly.plane.n;
             let r = d - 2.0 * d.dot(n) * n;
             // Mirrors are left out of the reflection (one level), and so is what lies behind
-            // the mirror's plane: the reflected ray never goes there.
+            // the mirror's plane: the reflected ray never goes there. The far plane cuts what
+            // the eye sees, the virtual image behind the mirror: `r` is as long as `d` (one
+            // unit of camera depth), so a point at `s` along it has its image at depth t + s.
             let mut best: Option<(u32, f64)> = None;
             let mut tmin = 1e-9;
-            while let Some((q, s)) = all.closest(scene, hit, r, tmin, f64::INFINITY) {
+            while let Some((q, s)) = all.closest(scene, hit, r, tmin, far - t) {
                 if scene.material(q as usize).mirror > 0.0 {
                     tmin = s * (1.0 + 1e-12) + 1e-12;
                     continue;

@@ -130,6 +130,10 @@ fn failed_writes_are_errors() {
 #[test]
 fn options_are_checked_wherever_they_are_used() {
     refused(&["render", SMALL, "-o", "x.jpg"], "PNG only");
+    refused(
+        &["export-shadows", SMALL, "-o", "x.obj", "--light", "5"],
+        "crow_pentagram_even_odd.toml: no light 5 (the scene has 1 light(s)",
+    );
     refused(&["render", SMALL, "-o", "x.png", "--gamma", "0"], "gamma");
     refused(&["render", SMALL, "-o", "x.png", "--gamma", "nan"], "gamma");
     refused(&["trace", SMALL, "--line", "3", "--x", "5000"], "outside the image");
@@ -146,6 +150,16 @@ fn options_are_checked_wherever_they_are_used() {
         &["compare", SMALL, "--shadows", "williams", "--map-size", "0", "--out", out.to_str().unwrap()],
         "map size 0",
     );
+    let sc = d.join("s");
+    let sc = sc.to_str().unwrap();
+    let sweep = ["scale", "--sweep", "cubes", "--values", "1", "--width", "32", "--height", "24", "--out", sc];
+    refused(
+        &[&sweep[..], &["--counter", "nope"]].concat(),
+        "no method here counts 'nope' (known visibility counters: ",
+    );
+    refused(&[&sweep[..], &["--counter", "colour.spans"]].concat(), "not visibility.NAME or shadow.NAME");
+    let (ok, err) = run(&[&sweep[..], &["--counter", "visibility.spans"]].concat());
+    assert!(ok, "{err}");
     // A kernel as wide as the map is fine.
     let (ok, err) = run(&[&["render", SMALL, "-o", "/dev/null", "--map-size", "3"][..], &w].concat());
     assert!(ok, "{err}");

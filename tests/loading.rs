@@ -158,6 +158,20 @@ fn byte_order_marks_and_bad_encodings() {
 }
 
 #[test]
+fn lone_carriage_returns_end_lines() {
+    let src = "[camera]\reye = [0.0, 0.0, 5.0]\rtarget = [0.0, 0.0, 0.0]\r[[light]]\rkind = \"point\"\rposition = [1.0, nan, 2.0]\r";
+    let e = load(src).unwrap_err();
+    assert!(e.starts_with("s.toml:6:"), "{e}");
+    let crlf = src.replace('\r', "\r\n");
+    let e = load(&crlf).unwrap_err();
+    assert!(e.starts_with("s.toml:6:"), "{e}");
+    let mesh = umbra::scene::parse_obj("v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r", Path::new("m.obj")).unwrap();
+    assert_eq!((mesh.positions.len(), mesh.faces.len()), (3, 1));
+    let e = umbra::scene::parse_obj("v 0 0 0\rv 1 x 0\r", Path::new("m.obj")).unwrap_err().to_string();
+    assert!(e.starts_with("m.obj:2:"), "{e}");
+}
+
+#[test]
 fn transforms_that_overflow_are_refused() {
     let e = err("[[object]]\nscale = 1e308\npolygons = [[[0.0,0.0,0.0],[10.0,0.0,0.0],[0.0,10.0,0.0]]]\n");
     assert!(e.contains("beyond the range of f64"), "{e}");

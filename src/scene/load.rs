@@ -249,6 +249,7 @@ impl Scene {
     pub fn from_toml(src: &str, file: &Path, dir: &Path) -> Result<Scene> {
         // A UTF-8 byte-order mark is not part of the first line.
         let src = src.strip_prefix('\u{feff}').unwrap_or(src);
+        let src = &crate::scene::lone_cr_to_lf(src);
         let cx = Ctx { file, src };
         let raw: RawScene = toml::from_str(src).map_err(|e| {
             let msg = e.message().trim().replace('\n', " ");

@@ -7,6 +7,19 @@ mod write;
 
 pub use obj::parse_obj;
 
+/// Old Mac line endings: a lone `\r` (no `\n` after it) becomes `\n`. Byte offsets do not
+/// change, so errors still point at the right line and column.
+pub(crate) fn lone_cr_to_lf(text: &str) -> std::borrow::Cow<'_, str> {
+    let bytes = text.as_bytes();
+    let lone = |i: usize| bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n');
+    if !(0..bytes.len()).any(lone) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let fixed: Vec<u8> = (0..bytes.len()).map(|i| if lone(i) { b'\n' } else { bytes[i] }).collect();
+    // Only ASCII bytes changed, so the text is still UTF-8.
+    std::borrow::Cow::Owned(String::from_utf8(fixed).unwrap_or_else(|_| text.to_owned()))
+}
+
 use crate::error::{Error, Result};
 use crate::geometry::{classify_face, newell_normal, FaceShape, Plane};
 use glam::{DMat3, DMat4, DVec3, Vec3};

@@ -14,6 +14,7 @@ use std::path::Path;
 pub fn parse_obj(text: &str, file: &Path) -> Result<Mesh> {
     // A UTF-8 byte-order mark is not part of the first line.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let text = &super::lone_cr_to_lf(text);
     let mut mesh = Mesh::default();
     let mut texcoords = 0usize;
     for (n, raw) in text.lines().enumerate() {

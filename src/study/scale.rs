@@ -132,8 +132,13 @@ pub struct Point {
 /// Runs the sweep, writes `scale.csv`, `time.svg` and `counter.svg` into `out`.
 pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     std::fs::create_dir_all(&o.out).map_err(|e| Error::Io { path: o.out.clone(), source: e })?;
+    let (kind, name) = o.counter.split_once('.').unwrap_or(("visibility", &o.counter));
+    if kind != "visibility" && kind != "shadow" {
+        return Err(Error::Invalid(format!("counter '{}' is not visibility.NAME or shadow.NAME", o.counter)));
+    }
     let mut points = Vec::new();
-    for &value in &o.values {
+    let mut known = std::collections::BTreeSet::new();
+    for (i, &value) in o.values.iter().enumerate() {
         let scene = o.sweep.scene(value, o)?;
         for &(v, s) in &o.methods {
             let opts = RenderOptions {
@@ -151,11 +156,9 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
             }
             times.sort_by(f64::total_cmp);
             let counter = last.map_or(0, |r| {
-                let (kind, name) = o.counter.split_once('.').unwrap_or(("visibility", &o.counter));
-                match kind {
-                    "shadow" => r.stats.shadow_counters.get(name),
-                    _ => r.stats.visibility_counters.get(name),
-                }
+                let counters = if kind == "shadow" { &r.stats.shadow_counters } else { &r.stats.visibility_counters };
+                known.extend(counters.iter().map(|(k, _)| k));
+                counters.get(name)
             });
             points.push(Point {
                 value,
@@ -165,6 +168,16 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
                 time_ms: times[times.len() / 2],
                 counter,
             });
+        }
+        // After the first point every method has reported its counters: a name none of them
+        // knows would plot zeros everywhere.
+        if i == 0 && !known.contains(name) {
+            let names: Vec<&str> = known.iter().copied().collect();
+            return Err(Error::Invalid(format!(
+                "no method here counts '{}' (known {kind} counters: {})",
+                o.counter,
+                names.join(", ")
+            )));
         }
     }
     let mut csv = format!("{},visibility,shadows,polygons,time_ms,{}\n", o.sweep.name(), o.counter);
