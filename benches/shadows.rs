@@ -78,11 +78,10 @@ fn atherton_weiler_greenberg(c: &mut Criterion) {
         for k in 0..10 {
             let mut s = scene.clone();
             let a = k as f64 * 0.2;
-            s.camera.eye = glam::DVec3::new(
-                s.camera.eye.x * a.cos() - s.camera.eye.z * a.sin(),
-                s.camera.eye.y,
-                s.camera.eye.x * a.sin() + s.camera.eye.z * a.cos(),
-            );
+            let mut c = s.camera().clone();
+            c.eye =
+                glam::DVec3::new(c.eye.x * a.cos() - c.eye.z * a.sin(), c.eye.y, c.eye.x * a.sin() + c.eye.z * a.cos());
+            s.set_camera(c).unwrap();
             views.push(s);
         }
         g.bench_function(BenchmarkId::new("ten-views-one-database", name), |b| {
@@ -99,7 +98,7 @@ fn planar(c: &mut Criterion) {
         ("cubes10", generate::cubes(10, true, W, H).unwrap()),
         ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap()),
     ] {
-        scene.objects[0].receiver = true;
+        scene.set_receiver(0, true).unwrap();
         let o = opts(ShadowMethod::Planar, ShadowOptions::default());
         g.bench_function(BenchmarkId::new("planar", name), |b| b.iter(|| render(&scene, &o).unwrap()));
     }

@@ -18,8 +18,12 @@ fn main() -> umbra::Result<()> {
         ..Default::default()
     };
     std::fs::create_dir_all(out).map_err(|e| umbra::Error::Io { path: out.to_owned(), source: e })?;
-    for (name, eye) in [("awg-detail", scene.camera.eye), ("awg-second-view", glam::DVec3::new(2.2, 4.8, 2.6))] {
-        scene.camera.eye = eye;
+    for (name, eye) in [("awg-detail", scene.camera().eye), ("awg-second-view", glam::DVec3::new(2.2, 4.8, 2.6))] {
+        {
+            let mut c = scene.camera().clone();
+            c.eye = eye;
+            scene.set_camera(c).expect("a valid camera");
+        }
         let r = render(&scene, &opts)?;
         let mut img = r.frame.color_image(None);
         Frame::draw_outlines(&mut img, &r.outlines, [255, 40, 200]);

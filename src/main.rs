@@ -379,8 +379,8 @@ fn run(cli: Cli) -> umbra::Result<()> {
         Command::Trace(a) => {
             let scene = Scene::load(&a.scene)?;
             let t = umbra::study::trace::trace(&scene, a.line, a.shadows, &a.shadow.options(false)?)?;
-            if let Some(x) = a.x.filter(|&x| x >= scene.camera.width) {
-                return Err(Error::Invalid(format!("--x {x} is outside the image (width {})", scene.camera.width)));
+            if let Some(x) = a.x.filter(|&x| x >= scene.camera().width) {
+                return Err(Error::Invalid(format!("--x {x} is outside the image (width {})", scene.camera().width)));
             }
             if a.json {
                 let json = serde_json::to_string_pretty(&t).map_err(|e| Error::Internal(e.to_string()))?;
@@ -391,12 +391,12 @@ fn run(cli: Cli) -> umbra::Result<()> {
         }
         Command::ExportShadows(e) => {
             let scene = Scene::load(&e.scene)?;
-            if e.light >= scene.lights.len() {
+            if e.light >= scene.lights().len() {
                 return Err(Error::Invalid(format!(
                     "{}: no light {} (the scene has {} light(s), numbered from 0)",
                     e.scene.display(),
                     e.light,
-                    scene.lights.len()
+                    scene.lights().len()
                 )));
             }
             let mut counters = umbra::Counters::default();

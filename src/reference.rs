@@ -60,7 +60,7 @@ impl<'a> Reference<'a> {
     /// let scene = umbra::generate::cubes(1, false, 32, 24)?;
     /// let oracle = umbra::reference::Reference::new(&scene);
     /// let centre = oracle.at(16.5, 12.5);
-    /// assert_eq!(centre.lit.len(), scene.lights.len());
+    /// assert_eq!(centre.lit.len(), scene.lights().len());
     /// # Ok::<(), umbra::Error>(())
     /// ```
     pub fn new(scene: &'a Scene) -> Self {

@@ -78,9 +78,9 @@ fn generate_writes_a_loadable_scene() {
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let s = umbra::Scene::load(d.join("c.toml")).unwrap();
-    assert_eq!(s.polygons.len(), 1 + 2 * 2 * 12);
+    assert_eq!(s.polygons().len(), 1 + 2 * 2 * 12);
     let direct = umbra::generate::cubes(2, true, 64, 48).unwrap();
-    assert_eq!(s.vertices, direct.vertices, "written and generated scenes are the same");
+    assert_eq!(s.vertices(), direct.vertices(), "written and generated scenes are the same");
 }
 
 #[test]

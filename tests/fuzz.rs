@@ -238,8 +238,16 @@ proptest! {
     fn mangled_scene_files(seed in 0usize..SEEDS.len(), edits in prop::collection::vec((any::<u8>(), any::<usize>(), any::<u8>()), 1..6)) {
         let text = mutate(SEEDS[seed], &edits);
         if let Some(mut scene) = load(&text) {
-            scene.camera.width = scene.camera.width.min(12);
-            scene.camera.height = scene.camera.height.min(9);
+            {
+                let mut c = scene.camera().clone();
+                c.width = scene.camera().width.min(12);
+                scene.set_camera(c).expect("a valid camera");
+            }
+            {
+                let mut c = scene.camera().clone();
+                c.height = scene.camera().height.min(9);
+                scene.set_camera(c).expect("a valid camera");
+            }
             if let Ok(out) = render(&scene, &RenderOptions::default()) {
                 prop_assert!(out.frame.color.iter().all(|c| c.is_finite()));
             }

@@ -87,11 +87,11 @@ fn camera_checks() {
     // Huge but finite vectors are scaled before they are normalised: no overflow, no
     // misleading error.
     let s = load("[camera]\neye = [0.0, 2.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\nup = [1e308, 1e308, 0.0]\n").unwrap();
-    let v = umbra::view::View::new(&s.camera);
+    let v = umbra::view::View::new(s.camera());
     assert!(v.r.is_finite() && v.u.is_finite(), "{:?} {:?}", v.r, v.u);
     let s = load(&format!("{CAMERA}[[light]]\nkind = \"directional\"\ndirection = [1e200, -1e200, 0.0]\n")).unwrap();
     assert!(
-        matches!(s.lights[0].kind, umbra::scene::LightKind::Directional { direction } if (direction.length() - 1.0).abs() < 1e-12)
+        matches!(s.lights()[0].kind, umbra::scene::LightKind::Directional { direction } if (direction.length() - 1.0).abs() < 1e-12)
     );
 }
 
@@ -148,7 +148,7 @@ fn byte_order_marks_and_bad_encodings() {
     let scene = format!("\u{feff}{CAMERA}[[object]]\nmesh = \"m.obj\"\n");
     std::fs::write(dir.join("s.toml"), &scene).unwrap();
     let s = Scene::load(dir.join("s.toml")).unwrap();
-    assert_eq!(s.polygons.len(), 1, "the BOM must not eat the first vertex");
+    assert_eq!(s.polygons().len(), 1, "the BOM must not eat the first vertex");
     let mut bad = scene.into_bytes();
     bad.extend_from_slice(b"# \xFF\n");
     std::fs::write(dir.join("bad.toml"), &bad).unwrap();
@@ -211,9 +211,9 @@ fn face_ids_run_across_objects_and_fans_keep_theirs() {
          [[object]]\npolygons = [\n [[0.0,0.0,0.0],[1.0,0.0,0.0],[1.0,1.0,0.5],[0.0,1.0,0.0]],\n]\n"
     ))
     .unwrap();
-    assert_eq!(s.face_count, 3);
+    assert_eq!(s.face_count(), 3);
     // Face 1 is degenerate (two vertices): it keeps its id and draws nothing.
-    let faces: Vec<u32> = s.polygons.iter().map(|p| p.face).collect();
+    let faces: Vec<u32> = s.polygons().iter().map(|p| p.face).collect();
     assert_eq!(faces, vec![0, 2, 2], "the non-planar face 2 is a fan of two triangles");
 }
 
@@ -242,6 +242,29 @@ fn every_example_scene_loads() {
 #[test]
 fn cornell_obj_negative_indices_and_fan() {
     let s = Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-obj.toml")).unwrap();
-    assert_eq!(s.face_count, 18);
-    assert!(s.polygons.len() > 18, "the non-planar wall is split into a fan");
+    assert_eq!(s.face_count(), 18);
+    assert!(s.polygons().len() > 18, "the non-planar wall is split into a fan");
+}
+
+/// A program cannot break what the loader checked: the camera, lights and materials are
+/// replaced through setters that check them, and asking a frame for a light it does not
+/// have is an answer, not a panic.
+#[test]
+fn the_api_keeps_the_loaders_invariants() {
+    let mut s =
+        load(&format!("{CAMERA}width = 16\nheight = 12\n[[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\n"))
+            .unwrap();
+    let mut c = s.camera().clone();
+    c.width = 0;
+    assert!(s.set_camera(c).unwrap_err().to_string().contains("size"));
+    let mut lights = s.lights().to_vec();
+    lights[0].attenuation = [0.0, 0.0, 0.0];
+    assert!(s.set_lights(lights).is_err());
+    let mut materials = s.materials().to_vec();
+    materials[0].roughness = f32::NAN;
+    assert!(s.set_materials(materials).is_err());
+    assert!(s.set_materials(Vec::new()).is_ok(), "no object refers to a material here");
+    assert!(s.set_receiver(3, true).is_err());
+    let f = umbra::render(&s, &umbra::RenderOptions::default()).unwrap().frame;
+    assert!(f.light_image(0).is_some() && f.light_image(1).is_none());
 }

@@ -31,7 +31,11 @@ fn the_far_plane_cuts_reflections_at_the_virtual_image() {
     let mut partly = false;
     for far in [6.0, 9.0, 11.0, 13.0, 16.0, 20.0] {
         let mut scene = mirror_scene();
-        scene.camera.far = Some(far);
+        {
+            let mut c = scene.camera().clone();
+            c.far = Some(far);
+            scene.set_camera(c).expect("a valid camera");
+        }
         let seen = agree_with_one_bounce(&scene);
         partly |= seen > 100 && seen + 100 < full;
     }
@@ -42,7 +46,7 @@ fn the_far_plane_cuts_reflections_at_the_virtual_image() {
 /// interior pixel; returns how many interior pixels see something in the mirror.
 fn agree_with_one_bounce(scene: &Scene) -> usize {
     let want = reference_mirror_ids(scene);
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let (w, h) = (scene.camera().width as usize, scene.camera().height as usize);
     let interior = |x: usize, y: usize| {
         x > 0
             && y > 0
@@ -93,8 +97,16 @@ fn the_two_methods_agree_on_colour() {
 fn a_mirror_seen_from_behind_reflects_nothing() {
     let mut scene = mirror_scene();
     // Look at the back of the mirror, from behind the wall.
-    scene.camera.eye = glam::DVec3::new(0.0, 1.5, -6.0);
-    scene.camera.target = glam::DVec3::new(0.0, 1.5, 0.0);
+    {
+        let mut c = scene.camera().clone();
+        c.eye = glam::DVec3::new(0.0, 1.5, -6.0);
+        scene.set_camera(c).expect("a valid camera");
+    }
+    {
+        let mut c = scene.camera().clone();
+        c.target = glam::DVec3::new(0.0, 1.5, 0.0);
+        scene.set_camera(c).expect("a valid camera");
+    }
     for method in [ReflectionMethod::ReflectEye, ReflectionMethod::ReflectScene] {
         assert!(mirror_ids(&scene, method).mirror_id.is_none());
     }

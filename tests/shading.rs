@@ -38,8 +38,8 @@ fn lit_at(m: &Material, p: DVec3, n: DVec3) -> Vec3 {
 }
 
 fn pixels(scene: &Scene) -> Vec<(u32, u32, DVec3)> {
-    let view = View::new(&scene.camera);
-    let plane = scene.polygons[0].plane;
+    let view = View::new(scene.camera());
+    let plane = scene.polygons()[0].plane;
     [(48, 36), (30, 50), (70, 40), (45, 60), (55, 30)]
         .iter()
         .map(|&(x, y)| (x, y, view.point_on(&plane, x as f64 + 0.5, y as f64 + 0.5)))
@@ -104,7 +104,7 @@ fn phong_highlight_peaks_at_the_mirror_point() {
     let mirror = DVec3::new(LIGHT.x, -LIGHT.y, LIGHT.z);
     let t = -mirror.y / (EYE.y - mirror.y);
     let peak = mirror + (EYE - mirror) * t;
-    let view = View::new(&s.camera);
+    let view = View::new(s.camera());
     let at = view.project(view.to_camera(peak));
     let (mut best, mut bx, mut by) = (0.0f32, 0, 0);
     for y in 0..72 {
@@ -131,7 +131,9 @@ fn phong_highlight_peaks_at_the_mirror_point() {
 #[test]
 fn attenuation_applies_per_pixel() {
     let mut s = scene("phong", "phong", "");
-    s.lights[0].attenuation = [0.5, 0.3, 0.2];
+    let mut lights = s.lights().to_vec();
+    lights[0].attenuation = [0.5, 0.3, 0.2];
+    s.set_lights(lights).unwrap();
     let f = draw(&s);
     for (x, y, p) in pixels(&s) {
         let d = (LIGHT - p).length();
@@ -145,10 +147,12 @@ fn attenuation_applies_per_pixel() {
 fn spot_cone_edge_is_where_the_cutoff_says() {
     let mut s = scene("phong", "phong", "");
     let axis = (DVec3::new(0.0, 0.0, 0.0) - LIGHT).normalize();
-    s.lights[0].kind = LightKind::Spot { position: LIGHT, direction: axis, cutoff: 25.0, exponent: 3.0 };
+    let mut lights = s.lights().to_vec();
+    lights[0].kind = LightKind::Spot { position: LIGHT, direction: axis, cutoff: 25.0, exponent: 3.0 };
+    s.set_lights(lights).unwrap();
     let f = draw(&s);
-    let view = View::new(&s.camera);
-    let plane = s.polygons[0].plane;
+    let view = View::new(s.camera());
+    let plane = s.polygons()[0].plane;
     let (mut inside, mut outside) = (0, 0);
     for y in 0..72 {
         for x in 0..96 {
@@ -185,13 +189,13 @@ fn area_light_half_lit_pixel() {
     let f = render(&s, &RenderOptions { shadows: ShadowMethod::RayCast, ..Default::default() }).unwrap().frame;
     // A floor point at x = 0.3 sees the +0.5 sample; its segment to the -0.5 sample crosses
     // x = 0 at height 0.75, through the wall (y 0.2..1.9).
-    let view = View::new(&s.camera);
+    let view = View::new(s.camera());
     let px = view.project(view.to_camera(DVec3::new(0.3, 0.0, 0.5)));
     let (x, y) = (px.x as u32, px.y as u32);
     let k = (y * 64 + x) as usize;
     assert_eq!(f.id[k], 0);
     assert_eq!(f.light[0][k], 0.5);
-    let p = view.point_on(&s.polygons[0].plane, x as f64 + 0.5, y as f64 + 0.5);
+    let p = view.point_on(&s.polygons()[0].plane, x as f64 + 0.5, y as f64 + 0.5);
     let sample = DVec3::new(0.5, 2.0, 0.0);
     let want = 0.5 * (sample - p).normalize().y as f32;
     assert!((f.color[k].x - want).abs() < 1e-5, "{} vs {want}", f.color[k].x);
@@ -200,15 +204,21 @@ fn area_light_half_lit_pixel() {
 #[test]
 fn gouraud_equals_flat_when_vertex_normals_are_the_face_normal() {
     let mut flat = scene("phong", "flat", "");
-    flat.materials[0].ks = 0.0;
-    flat.lights[0] = Light {
+    let mut materials = flat.materials().to_vec();
+    materials[0].ks = 0.0;
+    flat.set_materials(materials).unwrap();
+    let light = Light {
         kind: LightKind::Directional { direction: DVec3::new(0.3, -1.0, 0.2).normalize() },
-        ..flat.lights[0].clone()
+        ..flat.lights()[0].clone()
     };
+    flat.set_lights(vec![light]).unwrap();
     let mut gouraud = flat.clone();
-    gouraud.materials[0].shading = ShadingMode::Gouraud;
+    let mut materials = gouraud.materials().to_vec();
+    materials[0].shading = ShadingMode::Gouraud;
+    gouraud.set_materials(materials).unwrap();
     // Inline polygons share no vertices: their averaged normals are the face normal.
-    assert!(gouraud.normals.iter().all(|n| (*n - DVec3::Y).length() < 1e-12));
+    assert!((0..gouraud.polygons().len())
+        .all(|i| gouraud.vertex_normals(i).iter().all(|n| (*n - DVec3::Y).length() < 1e-12)));
     let (a, b) = (draw(&flat), draw(&gouraud));
     for (p, q) in a.color.iter().zip(&b.color) {
         assert!((*p - *q).abs().max_element() < 1e-6);
@@ -244,7 +254,7 @@ fn phong_shading_of_a_sphere_converges_to_the_analytic_sphere() {
         };
         let s = Scene::new(cam, Default::default(), vec![m.clone()], vec![light.clone()], vec![obj]).unwrap();
         let f = draw(&s);
-        let view = View::new(&s.camera);
+        let view = View::new(s.camera());
         let (mut sum, mut n) = (0.0f64, 0);
         for y in 0..96 {
             for x in 0..96 {

@@ -98,7 +98,7 @@ fn square_casts_its_central_projection() {
         light.x, light.y, light.z
     );
     let scene = Scene::from_toml(&src, std::path::Path::new("t.toml"), std::path::Path::new(".")).unwrap();
-    let view = umbra::view::View::new(&scene.camera);
+    let view = umbra::view::View::new(scene.camera());
     // The projection from the light of the square at height h onto y = 0 scales by
     // L.y / (L.y - h) about the light's foot.
     let k = light.y / (light.y - h);
@@ -114,7 +114,7 @@ fn square_casts_its_central_projection() {
                     if f.id[i] != 0 {
                         continue;
                     }
-                    let p = view.point_on(&scene.polygons[0].plane, x as f64 + 0.5, y as f64 + 0.5);
+                    let p = view.point_on(&scene.polygons()[0].plane, x as f64 + 0.5, y as f64 + 0.5);
                     let q = glam::DVec2::new(p.x, p.z);
                     let margin = (q - lo).min(hi - q).min_element();
                     if margin.abs() < 1e-9 {
@@ -178,10 +178,14 @@ fn one_shadow_database_serves_many_views() {
     let mut scene = load_scaled(&path, 200);
     let mut counters = umbra::Counters::default();
     let db: Vec<ShadowDatabase> =
-        (0..scene.lights.len()).map(|l| ShadowDatabase::build(&scene, l, &mut counters).unwrap()).collect();
+        (0..scene.lights().len()).map(|l| ShadowDatabase::build(&scene, l, &mut counters).unwrap()).collect();
     let db = Arc::new(db);
     for eye in [glam::DVec3::new(0.0, 5.0, 8.5), glam::DVec3::new(-6.0, 3.0, 2.0), glam::DVec3::new(4.0, 6.0, -5.0)] {
-        scene.camera.eye = eye;
+        {
+            let mut c = scene.camera().clone();
+            c.eye = eye;
+            scene.set_camera(c).expect("a valid camera");
+        }
         let fresh = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg);
         let options = umbra::shadow::ShadowOptions { awg_database: Some(db.clone()), ..Default::default() };
         let reused = frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg, options);

@@ -13,8 +13,16 @@ fn tmp(name: &str) -> std::path::PathBuf {
 #[test]
 fn compare_reports_every_method_and_a_valid_page() {
     let mut scene = Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/lights.toml")).unwrap();
-    scene.camera.width = 160;
-    scene.camera.height = 120;
+    {
+        let mut c = scene.camera().clone();
+        c.width = 160;
+        scene.set_camera(c).expect("a valid camera");
+    }
+    {
+        let mut c = scene.camera().clone();
+        c.height = 120;
+        scene.set_camera(c).expect("a valid camera");
+    }
     let out = tmp("compare");
     let opts = CompareOptions { runs: 1, out: out.clone(), ..CompareOptions::default() };
     let report = compare(&scene, "lights", &opts).unwrap();

@@ -29,9 +29,9 @@ fn random_scenes_agree_with_ray_cast() {
         let scene = random(seed, RandomOptions { width: 64, height: 48, ..RandomOptions::default() }).unwrap();
         let opts = umbra::RenderOptions { shadows: ShadowMethod::None, ..Default::default() };
         splits += umbra::render(&scene, &opts).unwrap().stats.visibility_counters.get("span_splits");
-        let view = umbra::view::View::new(&scene.camera);
-        clipped += (0..scene.polygons.len())
-            .filter(|&i| scene.verts(i).iter().any(|&p| view.to_camera(p).z < scene.camera.near))
+        let view = umbra::view::View::new(scene.camera());
+        clipped += (0..scene.polygons().len())
+            .filter(|&i| scene.verts(i).iter().any(|&p| view.to_camera(p).z < scene.camera().near))
             .count();
         let reference = frame(&scene, VisibilityMethod::RayCast, ShadowMethod::None);
         for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {

@@ -164,6 +164,29 @@ pub struct Material {
 }
 
 impl Material {
+    /// The loader's checks: finite values, `roughness > 0`, `shininess >= 0`, `fresnel` and
+    /// `mirror` in [0, 1].
+    pub(crate) fn validate(&self) -> std::result::Result<(), String> {
+        let finite = self.color.is_finite()
+            && self.specular_color.is_finite()
+            && [self.ka, self.kd, self.ks, self.shininess, self.roughness, self.fresnel, self.mirror]
+                .iter()
+                .all(|x| x.is_finite());
+        if !finite {
+            return Err("values must be finite".into());
+        }
+        if self.roughness <= 0.0 {
+            return Err(format!("roughness must be > 0, got {}", self.roughness));
+        }
+        if self.shininess < 0.0 {
+            return Err(format!("shininess must be >= 0, got {}", self.shininess));
+        }
+        if !(0.0..=1.0).contains(&self.fresnel) || !(0.0..=1.0).contains(&self.mirror) {
+            return Err("fresnel and mirror must be in [0, 1]".into());
+        }
+        Ok(())
+    }
+
     /// A material with the contract's defaults.
     pub fn new(name: impl Into<String>) -> Self {
         Material {
@@ -418,28 +441,24 @@ pub struct Polygon {
     pub plane: Plane,
 }
 
-/// A scene, as described and as compiled to world-space polygons.
+/// A scene, as described and as compiled to world-space polygons. Its parts are read through
+/// getters; the camera and the lights can be replaced through setters that check them, so a
+/// scene that loaded (or was built by [`Scene::new`]) stays valid: its compiled polygons
+/// always match its objects, and its camera and lights always pass the loader's checks.
 #[derive(Debug, Clone)]
 pub struct Scene {
-    /// The camera.
-    pub camera: Camera,
-    /// Global settings.
-    pub render: RenderSettings,
-    /// Materials (at least one).
-    pub materials: Vec<Material>,
-    /// Lights in file order.
-    pub lights: Vec<Light>,
-    /// Objects in file order.
-    pub objects: Vec<Object>,
+    pub(crate) camera: Camera,
+    pub(crate) render: RenderSettings,
+    pub(crate) materials: Vec<Material>,
+    pub(crate) lights: Vec<Light>,
+    pub(crate) objects: Vec<Object>,
     /// World-space polygons, degenerate faces left out, non-planar faces split into fans.
-    pub polygons: Vec<Polygon>,
+    pub(crate) polygons: Vec<Polygon>,
     /// Vertex positions of all polygons.
-    pub vertices: Vec<DVec3>,
-    /// Unit vertex normals, parallel to `vertices` (from `vn`, or averaged over the faces
-    /// sharing the vertex).
-    pub normals: Vec<DVec3>,
-    /// Number of face ids in the scene (degenerate faces included).
-    pub face_count: u32,
+    pub(crate) vertices: Vec<DVec3>,
+    /// Unit vertex normals, parallel to `vertices`.
+    pub(crate) normals: Vec<DVec3>,
+    pub(crate) face_count: u32,
 }
 
 impl Scene {
@@ -557,6 +576,102 @@ impl Scene {
             self.face_count += mesh.faces.len() as u32;
         }
         Ok(())
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// Replaces the camera, after the checks the loader makes (an error leaves the scene as
+    /// it was).
+    ///
+    /// ```
+    /// let mut scene = umbra::generate::cubes(1, false, 64, 48)?;
+    /// let mut camera = scene.camera().clone();
+    /// camera.width = 32;
+    /// scene.set_camera(camera.clone())?;
+    /// camera.width = 0;
+    /// assert!(scene.set_camera(camera).is_err());
+    /// assert_eq!(scene.camera().width, 32);
+    /// # Ok::<(), umbra::Error>(())
+    /// ```
+    pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
+        camera.validate().map_err(Error::Invalid)?;
+        self.camera = camera;
+        Ok(())
+    }
+
+    /// Global settings.
+    pub fn settings(&self) -> &RenderSettings {
+        &self.render
+    }
+
+    /// The materials (at least one).
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// Replaces the materials, after the checks the loader makes; every object's material
+    /// index must stay in range. An empty list gets the grey default, as in [`Scene::new`].
+    pub fn set_materials(&mut self, mut materials: Vec<Material>) -> Result<()> {
+        if materials.is_empty() {
+            materials.push(Material::new("default"));
+        }
+        for m in &materials {
+            m.validate().map_err(|e| Error::Invalid(format!("material '{}': {e}", m.name)))?;
+        }
+        if let Some((i, o)) = self.objects.iter().enumerate().find(|(_, o)| o.material >= materials.len()) {
+            return Err(Error::Invalid(format!("object {i}: material index {} out of range", o.material)));
+        }
+        self.materials = materials;
+        Ok(())
+    }
+
+    /// The lights, in file order.
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// Replaces the lights, after the checks the loader makes.
+    pub fn set_lights(&mut self, lights: Vec<Light>) -> Result<()> {
+        for (i, l) in lights.iter().enumerate() {
+            l.validate().map_err(|m| Error::Invalid(format!("light {i}: {m}")))?;
+        }
+        self.lights = lights;
+        Ok(())
+    }
+
+    /// The objects, in file order.
+    pub fn objects(&self) -> &[Object] {
+        &self.objects
+    }
+
+    /// Marks object `object` as a receiver of Blinn's planar shadows, or not.
+    pub fn set_receiver(&mut self, object: usize, receiver: bool) -> Result<()> {
+        let count = self.objects.len();
+        let o = self
+            .objects
+            .get_mut(object)
+            .ok_or_else(|| Error::Invalid(format!("no object {object} (the scene has {count})")))?;
+        o.receiver = receiver;
+        Ok(())
+    }
+
+    /// The compiled world-space polygons: degenerate faces left out, non-planar faces split
+    /// into fans.
+    pub fn polygons(&self) -> &[Polygon] {
+        &self.polygons
+    }
+
+    /// The vertex positions of all polygons.
+    pub fn vertices(&self) -> &[DVec3] {
+        &self.vertices
+    }
+
+    /// The number of face ids (degenerate faces included).
+    pub fn face_count(&self) -> u32 {
+        self.face_count
     }
 
     /// The vertices of polygon `i`.

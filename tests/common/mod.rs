@@ -22,10 +22,18 @@ pub fn scene_files() -> Vec<PathBuf> {
 /// Loads a scene and shrinks its image to at most `max_width` pixels wide (same aspect).
 pub fn load_scaled(path: &PathBuf, max_width: u32) -> Scene {
     let mut s = Scene::load(path).unwrap_or_else(|e| panic!("{e}"));
-    if s.camera.width > max_width {
-        let h = (s.camera.height as u64 * max_width as u64 / s.camera.width as u64).max(1) as u32;
-        s.camera.width = max_width;
-        s.camera.height = h;
+    if s.camera().width > max_width {
+        let h = (s.camera().height as u64 * max_width as u64 / s.camera().width as u64).max(1) as u32;
+        {
+            let mut c = s.camera().clone();
+            c.width = max_width;
+            s.set_camera(c).expect("a valid camera");
+        }
+        {
+            let mut c = s.camera().clone();
+            c.height = h;
+            s.set_camera(c).expect("a valid camera");
+        }
     }
     s
 }
