@@ -24,9 +24,11 @@ fn main() {
         .frame;
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
         for map_size in [512, 1024, 2048, 4096] {
-            for (bias_name, bias, slope) in
-                [("0", Some(0.0), 0.0), ("default", None, 1.5), ("1% of scene", Some(0.01 * extent), 1.5)]
-            {
+            for (bias_name, bias, slope) in [
+                ("0", Some(0.0), 0.0),
+                ("default", None, WilliamsOptions::default().slope_bias),
+                ("1% of scene", Some(0.01 * extent), WilliamsOptions::default().slope_bias),
+            ] {
                 for filter in [ShadowFilter::Nearest, ShadowFilter::Pcf(3)] {
                     let williams = WilliamsOptions { map_size, bias, slope_bias: slope, filter, ..Default::default() };
                     let opts = RenderOptions {

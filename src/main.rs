@@ -61,8 +61,9 @@ struct ShadowArgs {
     /// Williams: constant depth bias in world units (default: 0.1% of the scene's size).
     #[arg(long)]
     bias: Option<f64>,
-    /// Williams: slope-scaled bias, in texels times the tangent of the angle of incidence.
-    #[arg(long, default_value_t = 1.5)]
+    /// Williams: slope-scaled bias, times the receiver's own depth change over the texels a
+    /// lookup reaches in the map (the factor of glPolygonOffset).
+    #[arg(long, default_value_t = 1.0)]
     slope_bias: f64,
     /// Williams: nearest (one texel), pcf (percentage-closer filtering over --pcf-size²
     /// texels), or soft-edge (seed 002: PCF into a screen buffer, then a 15-tap Gaussian blur).

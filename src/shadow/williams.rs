@@ -11,15 +11,19 @@
 //! cone too. Optionally the polygons facing the light are culled (seed 003).
 //!
 //! **Pass 2** takes each visible point into the light's map and compares: `Z_map + bias <
-//! Z_pixel` means shadow, with `bias = constant + slope × texel size × tan θ × (r + 1)` (θ
-//! between the normal and the light at the polygon's centroid, r the filter kernel's radius
-//! in texels, since a wider kernel reaches texels farther down the slope). Filters: `nearest` (one texel), `pcf` (compare each of N×N texels,
+//! Z_pixel` means shadow. The bias is a constant plus a slope term that follows the receiver
+//! polygon's depth slope in the map's own texel space, as `glPolygonOffset` does: a planar
+//! polygon's nearness is affine in the texel coordinates, `a·x + b·y + c`, so the term
+//! `slope_bias × (|a| + |b|) × (r + 1)` (r the filter kernel's radius in texels, since a wider
+//! kernel reaches texels farther down the slope) is exact everywhere on the polygon, with no
+//! cap. Filters: `nearest` (one texel), `pcf` (compare each of N×N texels,
 //! then average the answers — never the depths), and `soft-edge` (seed 002: the PCF term of
 //! every pixel written to a screen-sized buffer, blurred by the seed's separable 15-tap
 //! Gaussian, and used when shading).
 
 use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
+use crate::geometry::Plane;
 use crate::scene::{Camera, LightSample};
 use crate::stats::Counters;
 use crate::view::{DepthPlane, ScreenPolygon, View};
@@ -47,7 +51,8 @@ pub struct WilliamsOptions {
     pub map_size: u32,
     /// Constant bias in world units along the light's axis; `None`: 0.1% of the scene's size.
     pub bias: Option<f64>,
-    /// Slope-scaled bias, in texels times the tangent of the angle of incidence.
+    /// Slope-scaled bias: this times the receiver's nearness change over the texels a
+    /// lookup reaches, in each map's texel space (the `factor` of `glPolygonOffset`).
     pub slope_bias: f64,
     /// Filter.
     pub filter: ShadowFilter,
@@ -62,7 +67,7 @@ impl Default for WilliamsOptions {
         WilliamsOptions {
             map_size: 2048,
             bias: None,
-            slope_bias: 1.5,
+            slope_bias: 1.0,
             filter: ShadowFilter::Pcf(3),
             cull_front: false,
             map_storage: MapStorage::default(),
@@ -172,13 +177,35 @@ impl Projection {
         }
     }
 
-    /// World size of a texel at depth `z`, as `(constant, per unit depth)`.
-    fn texel_size(&self) -> (f64, f64) {
+    /// A plane's nearness (what the map holds: `1/z`, or `−depth` for an orthographic map)
+    /// as an affine function of the texel coordinates; `None` when the plane is edge-on to
+    /// the light.
+    fn depth_plane(&self, plane: &Plane) -> Option<DepthPlane> {
         match self {
-            Projection::Perspective(view) => (0.0, 2.0 * view.t / view.height as f64),
-            Projection::Ortho { texel, .. } => (*texel, 0.0),
+            Projection::Perspective(view) => view.depth_plane(plane),
+            Projection::Ortho { u, v, d, u0, v0, s0, texel } => {
+                let nd = plane.n.dot(*d);
+                if nd == 0.0 {
+                    return None;
+                }
+                let o = *u * *u0 + *v * *v0 + *d * *s0;
+                Some(DepthPlane {
+                    a: texel * plane.n.dot(*u) / nd,
+                    b: -texel * plane.n.dot(*v) / nd,
+                    c: plane.distance(o) / nd,
+                })
+            }
         }
     }
+}
+
+/// The bias of one receiver polygon: `constant` in world units along the light's axis, and
+/// `slope` times the receiver plane's nearness change over the texels a lookup reaches,
+/// taken in each map's own texel space (the polygon offset of `glPolygonOffset`).
+struct Bias {
+    constant: f64,
+    slope: f64,
+    plane: Plane,
 }
 
 /// Texels added to each row of a map: rows a power of two apart would otherwise share
@@ -231,20 +258,9 @@ impl DepthMap {
                     })
                     .collect()
             }
-            Projection::Ortho { u, v, d, u0, v0, s0, texel } => casters
+            Projection::Ortho { u, v, u0, v0, texel, .. } => casters
                 .filter_map(|i| {
-                    let plane = &scene.polygons[i].plane;
-                    let nd = plane.n.dot(*d);
-                    if nd == 0.0 {
-                        return None;
-                    }
-                    // Nearness −s as an affine function of the texel coordinates.
-                    let o = *u * *u0 + *v * *v0 + *d * *s0;
-                    let depth = DepthPlane {
-                        a: texel * plane.n.dot(*u) / nd,
-                        b: -texel * plane.n.dot(*v) / nd,
-                        c: (plane.distance(o)) / nd,
-                    };
+                    let depth = proj.depth_plane(&scene.polygons[i].plane)?;
                     let ring = scene
                         .verts(i)
                         .iter()
@@ -259,27 +275,20 @@ impl DepthMap {
         DepthMap { rows: proj.rows(), proj, size, nearness, storage }
     }
 
-    /// Pass 2 along a run: the lit value at each point `h0 + i·step` (homogeneous, `w > 0`)
-    /// under a `(2r+1)²` kernel, with bias `b0 + b1 × depth` where `(b0, b1)` is `constant`
-    /// plus `slope` texels. The run is taken in batches: first every point of a batch is
-    /// located in the map, four at a time in vector registers, then every kernel is
-    /// compared.
-    fn lit_run(
-        &self,
-        h0: DVec4,
-        step: DVec4,
-        (constant, slope): (f64, f64),
-        r: usize,
-        batch: &mut Located,
-        out: &mut [f32],
-    ) {
+    /// Pass 2 along a run on the receiver plane `bias.plane`: the lit value at each point
+    /// `h0 + i·step` (homogeneous, `w > 0`) under a `(2r+1)²` kernel. The run is taken in
+    /// batches: first every point of a batch is located in the map, four at a time in vector
+    /// registers, then every kernel is compared.
+    fn lit_run(&self, h0: DVec4, step: DVec4, bias: &Bias, r: usize, batch: &mut Located, out: &mut [f32]) {
         let [rx, ry, rz] = self.rows;
         // In single precision from here: its rounding (a few parts in 10⁷ of the depth) is
         // far below any bias, and the map holds single-precision nearness anyway.
         let at = |h: DVec4| DVec4::new(rx.dot(h), ry.dot(h), rz.dot(h), h.w).as_vec4().to_array();
         let (l0, dl) = (at(h0), at(step));
-        let (t0, t1) = self.proj.texel_size();
-        let (b0, b1) = ((constant + slope * t0) as f32, (slope * t1) as f32);
+        // The slope-scaled term, in nearness: how much the receiver's own nearness changes
+        // over the texels the kernel reaches (r + ½ each way, rounded up to r + 1).
+        let slope = self.proj.depth_plane(&bias.plane).map_or(0.0, |d| d.a.abs() + d.b.abs());
+        let (b0, bs) = (bias.constant as f32, (bias.slope * slope * (r + 1) as f64) as f32);
         for (b, out) in out.chunks_mut(BATCH).enumerate() {
             let groups = out.len().div_ceil(4);
             for g in 0..groups {
@@ -287,21 +296,22 @@ impl DepthMap {
                 // The four points in light space.
                 let [x, y, z, w] = [0, 1, 2, 3].map(|c| f32x4::splat(l0[c]) + f32x4::splat(dl[c]) * t);
                 let (px, py, threshold) = match self.proj {
-                    // `Z_map + bias < z` means shadow, that is `1/Z_map > 1/(z − bias)` with
-                    // `z = Z/w`: the threshold is `w / (Z(1 − b1) − b0·w)`. A point behind
-                    // the light, or within the bias of it, is lit: it goes far outside the
-                    // map.
+                    // `Z_map + b0 < z` means shadow, that is `1/Z_map > 1/(z − b0)` with
+                    // `z = Z/w`; the slope term is added in nearness: the threshold is
+                    // `w / (Z − b0·w) + bs`. A point behind the light, or within the bias of
+                    // it, is lit: it goes far outside the map.
                     Projection::Perspective(_) => {
-                        let denom = z * (1.0 - b1) - w * b0;
+                        let denom = z - w * b0;
                         let ahead = z.simd_gt(0.0) & denom.simd_gt(0.0);
                         let q = f32x4::ONE / z;
                         let far = f32x4::splat(f32::NEG_INFINITY);
-                        (ahead.select(x * q, far), ahead.select(y * q, far), ahead.select(w / denom, -far))
+                        let threshold = w / denom + f32x4::splat(bs);
+                        (ahead.select(x * q, far), ahead.select(y * q, far), ahead.select(threshold, -far))
                     }
-                    // The map holds `−Z_map`: shadow when `−Z_map > bias − z`.
+                    // The map holds `−Z_map`: shadow when `−Z_map > b0 − z + bs`.
                     Projection::Ortho { .. } => {
                         let q = f32x4::ONE / w;
-                        (x * q, y * q, f32x4::splat(b0) - z * q)
+                        (x * q, y * q, f32x4::splat(b0 + bs) - z * q)
                     }
                 };
                 batch.put(g, px, py, threshold, r, self.size);
@@ -516,7 +526,7 @@ impl LightMaps {
 
     /// Pass 2 along a run (see [`DepthMap::lit_run`]); a cube's run is cut where the face
     /// holding its points changes.
-    fn lit_run(&self, h0: DVec4, step: DVec4, bias: (f64, f64), r: usize, batch: &mut Located, out: &mut [f32]) {
+    fn lit_run(&self, h0: DVec4, step: DVec4, bias: &Bias, r: usize, batch: &mut Located, out: &mut [f32]) {
         match self {
             LightMaps::Single(map) => map.lit_run(h0, step, bias, r, batch, out),
             LightMaps::Cube(faces, s) => {
@@ -555,8 +565,6 @@ pub struct Williams<'a> {
     options: WilliamsOptions,
     bias: f64,
     maps: Vec<LightMaps>,
-    /// Each visible polygon's centroid, where its slope-scaled bias is taken.
-    centroids: Vec<DVec3>,
     /// Soft-edge filter: each sample's blurred screen buffer.
     blurred: Vec<Vec<f32>>,
 }
@@ -571,12 +579,7 @@ impl<'a> Williams<'a> {
         let samples: Vec<_> = ctx.all_samples().collect();
         let maps = samples.iter().map(|&(_, _, s)| LightMaps::new(ctx, s, &options, counters)).collect();
         counters.add("map_texels", (options.map_size as u64).pow(2));
-        let scene = ctx.scene;
-        let centroids = (0..scene.polygons.len())
-            .into_par_iter()
-            .map(|i| if ctx.visible[i] { crate::geometry::centroid(scene.verts(i)) } else { DVec3::ZERO })
-            .collect();
-        let mut stage = Williams { ctx, options, bias, maps, centroids, blurred: Vec::new() };
+        let mut stage = Williams { ctx, options, bias, maps, blurred: Vec::new() };
         if let ShadowFilter::SoftEdge(_) = stage.options.filter {
             stage.blurred = samples.iter().map(|&(l, s, _)| stage.soft_edge_buffer(l, s)).collect();
         }
@@ -615,8 +618,8 @@ impl<'a> Williams<'a> {
     /// Pass 2 for the pixels of `run` on line `line` (written to `out`): the
     /// filtered lit value of sample `s` of light `light`. The visible point, in homogeneous
     /// form `(eye·D − dist·ray, D)` with `D = n·ray`, is linear in the ray, so it is stepped
-    /// along the line rather than recomputed. The slope-scaled bias takes the polygon's
-    /// angle to the light at its centroid, once per polygon, as `glPolygonOffset` does.
+    /// along the line rather than recomputed. The slope-scaled bias follows the receiver's
+    /// depth slope in each map, as `glPolygonOffset` does.
     fn lookup_run(&self, light: usize, s: usize, line: u32, run: &Run, batch: &mut Located, out: &mut [f32]) {
         let poly = run.poly as usize;
         let view = self.ctx.view;
@@ -630,14 +633,9 @@ impl<'a> Williams<'a> {
         let step = point_h(view.ray_step());
         // Keep w > 0 so the maps' divisions read the right way round.
         let flip = if h0.w < 0.0 { -1.0 } else { 1.0 };
-        let (l, _) = self.ctx.samples[light][s].toward(self.centroids[poly]);
-        let cos = plane.n.dot(l).abs().max(1e-3);
-        let tan = ((1.0 - cos * cos).sqrt() / cos).min(10.0);
-        // A wider kernel reaches texels farther along the slope.
-        let r = self.kernel_radius();
-        let slope = self.options.slope_bias * (r + 1) as f64 * tan;
+        let bias = Bias { constant: self.bias, slope: self.options.slope_bias, plane: *plane };
         let map = &self.maps[self.ctx.sample_index(light, s)];
-        map.lit_run(h0 * flip, step * flip, (self.bias, slope), r, batch, out);
+        map.lit_run(h0 * flip, step * flip, &bias, self.kernel_radius(), batch, out);
     }
 
     /// Seed 002: the N×N PCF term of every visible pixel in a screen-sized buffer (1 where

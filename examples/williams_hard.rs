@@ -1,0 +1,43 @@
+//! The share of interior pixels where Williams' shadow map (default options, or the given map
+//! size) differs from ray-cast, for each scene given:
+//! `cargo run --release --example williams_hard -- scenes/grazing-light.toml ...`
+use umbra::shadow::{ShadowOptions, WilliamsOptions};
+use umbra::study::compare::diff;
+use umbra::{render, RenderOptions, Scene, ShadowMethod};
+
+fn main() {
+    for path in std::env::args().skip(1) {
+        let scene = Scene::load(&path).unwrap();
+        let reference =
+            render(&scene, &RenderOptions { shadows: ShadowMethod::RayCast, ..Default::default() }).unwrap().frame;
+        let williams = WilliamsOptions::default();
+        let opts = RenderOptions {
+            shadows: ShadowMethod::Williams,
+            shadow_options: ShadowOptions { williams, ..Default::default() },
+            ..Default::default()
+        };
+        let got = render(&scene, &opts).unwrap().frame;
+        let (interior, wrong, _) = diff(&reference, &got);
+        println!(
+            "{path}: {:.2}% ({wrong} of {interior}) interior pixels wrong",
+            100.0 * wrong as f64 / interior.max(1) as f64
+        );
+        if let Ok(out) = std::env::var("DIFF_PNG") {
+            // Grey: agrees; red: the map lights what is in shadow; blue: the map shadows what is lit.
+            let img = image::RgbImage::from_fn(got.width, got.height, |x, y| {
+                let k = (y * got.width + x) as usize;
+                let (want, have): (f32, f32) =
+                    (reference.light.iter().map(|l| l[k]).sum(), got.light.iter().map(|l| l[k]).sum());
+                let g = (40.0 + 60.0 * want) as u8;
+                if (want - have).abs() < 0.25 {
+                    image::Rgb([g, g, g])
+                } else if have > want {
+                    image::Rgb([230, 30, 30])
+                } else {
+                    image::Rgb([30, 60, 230])
+                }
+            });
+            img.save(&out).unwrap();
+        }
+    }
+}
