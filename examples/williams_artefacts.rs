@@ -14,6 +14,7 @@ fn main() -> umbra::Result<()> {
             map_size: 512,
             bias: Some(0.0),
             slope_bias: 0.0,
+            normal_offset: 0.0,
             filter: ShadowFilter::Nearest,
             ..Default::default()
         },

@@ -1,5 +1,6 @@
-//! The share of interior pixels where Williams' shadow map (default options, or the given map
-//! size) differs from ray-cast, for each scene given:
+//! The share of interior pixels where Williams' shadow map (default options; `SLOPE` and
+//! `NORMAL` in the environment set the slope bias and the normal offset) differs from
+//! ray-cast, for each scene given:
 //! `cargo run --release --example williams_hard -- scenes/grazing-light.toml ...`
 use umbra::shadow::{ShadowOptions, WilliamsOptions};
 use umbra::study::compare::diff;
@@ -10,7 +11,13 @@ fn main() {
         let scene = Scene::load(&path).unwrap();
         let reference =
             render(&scene, &RenderOptions { shadows: ShadowMethod::RayCast, ..Default::default() }).unwrap().frame;
-        let williams = WilliamsOptions::default();
+        let var = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<f64>().ok());
+        let d = WilliamsOptions::default();
+        let williams = WilliamsOptions {
+            slope_bias: var("SLOPE").unwrap_or(d.slope_bias),
+            normal_offset: var("NORMAL").unwrap_or(d.normal_offset),
+            ..d
+        };
         let opts = RenderOptions {
             shadows: ShadowMethod::Williams,
             shadow_options: ShadowOptions { williams, ..Default::default() },

@@ -24,13 +24,21 @@ fn main() {
         .frame;
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
         for map_size in [512, 1024, 2048, 4096] {
-            for (bias_name, bias, slope) in [
-                ("0", Some(0.0), 0.0),
-                ("default", None, WilliamsOptions::default().slope_bias),
-                ("1% of scene", Some(0.01 * extent), WilliamsOptions::default().slope_bias),
+            let d = WilliamsOptions::default();
+            for (bias_name, bias, slope, normal) in [
+                ("0", Some(0.0), 0.0, 0.0),
+                ("default", None, d.slope_bias, d.normal_offset),
+                ("1% of scene", Some(0.01 * extent), d.slope_bias, d.normal_offset),
             ] {
                 for filter in [ShadowFilter::Nearest, ShadowFilter::Pcf(3)] {
-                    let williams = WilliamsOptions { map_size, bias, slope_bias: slope, filter, ..Default::default() };
+                    let williams = WilliamsOptions {
+                        map_size,
+                        bias,
+                        slope_bias: slope,
+                        normal_offset: normal,
+                        filter,
+                        ..Default::default()
+                    };
                     let opts = RenderOptions {
                         shadows: ShadowMethod::Williams,
                         shadow_options: ShadowOptions { williams, ..Default::default() },

@@ -62,9 +62,14 @@ struct ShadowArgs {
     #[arg(long)]
     bias: Option<f64>,
     /// Williams: slope-scaled bias, times the receiver's own depth change over the texels a
-    /// lookup reaches in the map (the factor of glPolygonOffset).
-    #[arg(long, default_value_t = 1.0)]
+    /// lookup reaches in the map (the factor of glPolygonOffset; 0, the default, is off:
+    /// the normal offset does its work without detaching shadows at grazing angles).
+    #[arg(long, default_value_t = 0.0)]
     slope_bias: f64,
+    /// Williams: move each lookup along the receiver's normal by this many texels of the map
+    /// (normal-offset shadows; 0 is off).
+    #[arg(long, default_value_t = 2.0)]
+    normal_offset: f64,
     /// Williams: nearest (one texel), pcf (percentage-closer filtering over --pcf-size²
     /// texels), or soft-edge (seed 002: PCF into a screen buffer, then a 15-tap Gaussian blur).
     #[arg(long, value_enum, default_value = "pcf")]
@@ -92,6 +97,7 @@ impl ShadowArgs {
                 map_size: self.map_size,
                 bias: self.bias,
                 slope_bias: self.slope_bias,
+                normal_offset: self.normal_offset,
                 filter,
                 cull_front: self.cull_front,
                 ..WilliamsOptions::default()

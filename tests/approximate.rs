@@ -89,6 +89,7 @@ fn shadow_map_without_bias_shows_acne() {
             map_size: 512,
             bias: Some(0.0),
             slope_bias: 0.0,
+            normal_offset: 0.0,
             filter: ShadowFilter::Nearest,
             ..WilliamsOptions::default()
         },
@@ -203,4 +204,25 @@ fn default_map_holds_on_every_example_scene() {
         let e = default_map_error(&Scene::load(&path).unwrap());
         assert!(e <= 0.02, "{}: {:.2}% wrong", path.display(), 100.0 * e);
     }
+}
+
+/// Shadows stay attached at grazing contact. With the light 2 cm above the floor, the
+/// floor is almost edge-on in the map. A bias that follows the slope there (glPolygonOffset's
+/// factor) grows so large that it swallows each block's shadow near its foot, in bands many
+/// pixels wide (peter-panning). The default normal offset leaves only the pixels along the
+/// shadows' edges wrong: none more than 3 pixels from an edge (light 0, the floor light).
+#[test]
+fn shadows_stay_attached_at_grazing_contact() {
+    let scene = example("grazing-light.toml");
+    let want = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::RayCast);
+    let with = |williams: WilliamsOptions| {
+        let options = ShadowOptions { williams, ..ShadowOptions::default() };
+        frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams, options)
+    };
+    let slope_only = with(WilliamsOptions { slope_bias: 1.0, normal_offset: 0.0, ..WilliamsOptions::default() });
+    let (_, detached) = errors_away_from_edges(&want, &slope_only, 3);
+    assert!(detached.len() > 1000, "the slope bias should detach shadows here: {} pixels", detached.len());
+    let (wrong, far) = errors_away_from_edges(&want, &with(WilliamsOptions::default()), 3);
+    eprintln!("slope bias: {} detached; normal offset: {} of {wrong} far from edges", detached.len(), far.len());
+    assert!(far.len() < 50, "{} of {wrong} wrong pixels lie more than 3 pixels from a shadow edge", far.len());
 }

@@ -11,12 +11,15 @@
 //! cone too. Optionally the polygons facing the light are culled (seed 003).
 //!
 //! **Pass 2** takes each visible point into the light's map and compares: `Z_map + bias <
-//! Z_pixel` means shadow. The bias is a constant plus a slope term that follows the receiver
-//! polygon's depth slope in the map's own texel space, as `glPolygonOffset` does: a planar
-//! polygon's nearness is affine in the texel coordinates, `a·x + b·y + c`, so the term
-//! `slope_bias × (|a| + |b|) × (r + 1)` (r the filter kernel's radius in texels, since a wider
-//! kernel reaches texels farther down the slope) is exact everywhere on the polygon, with no
-//! cap. Filters: `nearest` (one texel), `pcf` (compare each of N×N texels,
+//! Z_pixel` means shadow. Three remedies against acne combine (`docs/algorithms/williams.md`,
+//! "The bias"): a constant; a **normal offset** (Holbert 2011), the lookup point moved along
+//! the receiver's normal by a number of the map's texels at its depth (the default, 2); and a
+//! **slope term** that follows the receiver polygon's depth slope in the map's own texel
+//! space, as `glPolygonOffset` does: a planar polygon's nearness is affine in the texel
+//! coordinates, `a·x + b·y + c`, so `slope_bias × (|a| + |b|) × (r + 1)` (r the filter
+//! kernel's radius in texels) is exact everywhere on the polygon, with no cap (off by
+//! default: at grazing angles it detaches shadows). Filters: `nearest` (one texel), `pcf`
+//! (compare each of N×N texels,
 //! then average the answers — never the depths), and `soft-edge` (seed 002: the PCF term of
 //! every pixel written to a screen-sized buffer, blurred by the seed's separable 15-tap
 //! Gaussian, and used when shading).
@@ -54,6 +57,9 @@ pub struct WilliamsOptions {
     /// Slope-scaled bias: this times the receiver's nearness change over the texels a
     /// lookup reaches, in each map's texel space (the `factor` of `glPolygonOffset`).
     pub slope_bias: f64,
+    /// Normal offset (Holbert 2011): each lookup point is moved along the receiver's normal,
+    /// toward the light's side, by this many of the map's texels at its depth (0: off).
+    pub normal_offset: f64,
     /// Filter.
     pub filter: ShadowFilter,
     /// Leave out polygons facing the light in pass 1 (seed 003).
@@ -67,7 +73,8 @@ impl Default for WilliamsOptions {
         WilliamsOptions {
             map_size: 2048,
             bias: None,
-            slope_bias: 1.0,
+            slope_bias: 0.0,
+            normal_offset: 2.0,
             filter: ShadowFilter::Pcf(3),
             cull_front: false,
             map_storage: MapStorage::default(),
@@ -98,7 +105,9 @@ impl WilliamsOptions {
                 return fail(format!("kernel size {n} is wider than the {0}x{0} map", self.map_size));
             }
         }
-        for (name, v) in [("bias", self.bias.unwrap_or(0.0)), ("slope bias", self.slope_bias)] {
+        for (name, v) in
+            [("bias", self.bias.unwrap_or(0.0)), ("slope bias", self.slope_bias), ("normal offset", self.normal_offset)]
+        {
             if !(v.is_finite() && v >= 0.0) {
                 return fail(format!("{name} {v} is not a finite number ≥ 0"));
             }
@@ -206,6 +215,9 @@ struct Bias {
     constant: f64,
     slope: f64,
     plane: Plane,
+    /// The normal offset in texels, and the receiver's normal turned to the light's side.
+    offset: f64,
+    normal: DVec3,
 }
 
 /// Texels added to each row of a map: rows a power of two apart would otherwise share
@@ -275,12 +287,28 @@ impl DepthMap {
         DepthMap { rows: proj.rows(), proj, size, nearness, storage }
     }
 
+    /// The homogeneous point `h = (w·p, w)` moved along the receiver's normal by
+    /// `bias.offset` texels of this map at its depth. A perspective map's texel at depth `z`
+    /// (`z = rz·h / w`) is `2·t/size · z` wide, so the moved point `h + (n·k·rz·h, 0)` is
+    /// linear in `h`, and a run's start and step can be moved alike.
+    fn offset_point(&self, h: DVec4, bias: &Bias) -> DVec4 {
+        if bias.offset == 0.0 {
+            return h;
+        }
+        let shift = match &self.proj {
+            Projection::Perspective(view) => 2.0 * view.t / view.height as f64 * self.rows[2].dot(h),
+            Projection::Ortho { texel, .. } => texel * h.w,
+        };
+        h + (bias.normal * (bias.offset * shift)).extend(0.0)
+    }
+
     /// Pass 2 along a run on the receiver plane `bias.plane`: the lit value at each point
     /// `h0 + i·step` (homogeneous, `w > 0`) under a `(2r+1)²` kernel. The run is taken in
     /// batches: first every point of a batch is located in the map, four at a time in vector
     /// registers, then every kernel is compared.
     fn lit_run(&self, h0: DVec4, step: DVec4, bias: &Bias, r: usize, batch: &mut Located, out: &mut [f32]) {
         let [rx, ry, rz] = self.rows;
+        let (h0, step) = (self.offset_point(h0, bias), self.offset_point(step, bias));
         // In single precision from here: its rounding (a few parts in 10⁷ of the depth) is
         // far below any bias, and the map holds single-precision nearness anyway.
         let at = |h: DVec4| DVec4::new(rx.dot(h), ry.dot(h), rz.dot(h), h.w).as_vec4().to_array();
@@ -633,7 +661,15 @@ impl<'a> Williams<'a> {
         let step = point_h(view.ray_step());
         // Keep w > 0 so the maps' divisions read the right way round.
         let flip = if h0.w < 0.0 { -1.0 } else { 1.0 };
-        let bias = Bias { constant: self.bias, slope: self.options.slope_bias, plane: *plane };
+        // The normal turned to the light's side, which the same-side rule makes the seen side.
+        let normal = if dist >= 0.0 { plane.n } else { -plane.n };
+        let bias = Bias {
+            constant: self.bias,
+            slope: self.options.slope_bias,
+            plane: *plane,
+            offset: self.options.normal_offset,
+            normal,
+        };
         let map = &self.maps[self.ctx.sample_index(light, s)];
         map.lit_run(h0 * flip, step * flip, &bias, self.kernel_radius(), batch, out);
     }
