@@ -58,7 +58,8 @@ struct ShadowArgs {
     /// Williams: texels along each side of a shadow map.
     #[arg(long, default_value_t = 2048)]
     map_size: u32,
-    /// Williams: constant depth bias in world units (default: 0.1% of the scene's size).
+    /// Williams: constant depth bias in world units (default: one texel of depth at each
+    /// point, which follows the map's resolution).
     #[arg(long)]
     bias: Option<f64>,
     /// Williams: slope-scaled bias, times the receiver's own depth change over the texels a
@@ -80,6 +81,9 @@ struct ShadowArgs {
     /// Williams: leave polygons facing the light out of the depth map (seed 003).
     #[arg(long)]
     cull_front: bool,
+    /// Williams: fit each map to the whole scene, not to the points the camera sees.
+    #[arg(long)]
+    no_fit: bool,
 }
 
 impl ShadowArgs {
@@ -100,6 +104,7 @@ impl ShadowArgs {
                 normal_offset: self.normal_offset,
                 filter,
                 cull_front: self.cull_front,
+                fit_to_view: !self.no_fit,
                 ..WilliamsOptions::default()
             },
             awg_database: None,

@@ -52,7 +52,8 @@ pub enum ShadowFilter {
 pub struct WilliamsOptions {
     /// Texels along each side of a map.
     pub map_size: u32,
-    /// Constant bias in world units along the light's axis; `None`: 0.1% of the scene's size.
+    /// Constant bias in world units along the light's axis; `None`: one texel of depth at
+    /// the point (a texel's width there: it follows the map's resolution and the depth).
     pub bias: Option<f64>,
     /// Slope-scaled bias: this times the receiver's nearness change over the texels a
     /// lookup reaches, in each map's texel space (the `factor` of `glPolygonOffset`).
@@ -64,6 +65,10 @@ pub struct WilliamsOptions {
     pub filter: ShadowFilter,
     /// Leave out polygons facing the light in pass 1 (seed 003).
     pub cull_front: bool,
+    /// Fit each orthographic map, and each single perspective map, to the points the camera
+    /// sees rather than to the whole scene (what production engines do; cube maps are not
+    /// fitted).
+    pub fit_to_view: bool,
     /// Memory for the maps, shared by clones of these options and kept between renders.
     pub map_storage: MapStorage,
 }
@@ -77,6 +82,7 @@ impl Default for WilliamsOptions {
             normal_offset: 2.0,
             filter: ShadowFilter::Pcf(3),
             cull_front: false,
+            fit_to_view: true,
             map_storage: MapStorage::default(),
         }
     }
@@ -208,11 +214,33 @@ impl Projection {
     }
 }
 
+/// The world points at the first and last pixel centre of every visible run: each run is a
+/// segment of a planar polygon, so these bound every point the camera sees.
+fn visible_points(ctx: &ShadowContext) -> Vec<DVec3> {
+    let mut pts = Vec::new();
+    for (y, runs) in ctx.runs.lines.iter().enumerate() {
+        let yc = y as f64 + 0.5;
+        for r in runs {
+            let plane = &ctx.scene.polygons[r.poly as usize].plane;
+            for x in [r.x0, r.x1.saturating_sub(1).max(r.x0)] {
+                let p = ctx.view.point_on(plane, x as f64 + 0.5, yc);
+                if p.is_finite() {
+                    pts.push(p);
+                }
+            }
+        }
+    }
+    pts
+}
+
 /// The bias of one receiver polygon: `constant` in world units along the light's axis, and
 /// `slope` times the receiver plane's nearness change over the texels a lookup reaches,
 /// taken in each map's own texel space (the polygon offset of `glPolygonOffset`).
 struct Bias {
     constant: f64,
+    /// A constant in texels of depth: a perspective map's texel is `2·t/size` times the
+    /// depth wide, an orthographic map's one `texel`.
+    texels: f64,
     slope: f64,
     plane: Plane,
     /// The normal offset in texels, and the receiver's normal turned to the light's side.
@@ -317,6 +345,12 @@ impl DepthMap {
         // over the texels the kernel reaches (r + ½ each way, rounded up to r + 1).
         let slope = self.proj.depth_plane(&bias.plane).map_or(0.0, |d| d.a.abs() + d.b.abs());
         let (b0, bs) = (bias.constant as f32, (bias.slope * slope * (r + 1) as f64) as f32);
+        // The constant in texels of depth: relative to the depth for a perspective map
+        // (`b1`), absolute for an orthographic one (folded into `b0`).
+        let (b0, b1) = match &self.proj {
+            Projection::Perspective(view) => (b0, (bias.texels * 2.0 * view.t / view.height as f64) as f32),
+            Projection::Ortho { texel, .. } => (b0 + (bias.texels * texel) as f32, 0.0),
+        };
         for (b, out) in out.chunks_mut(BATCH).enumerate() {
             let groups = out.len().div_ceil(4);
             for g in 0..groups {
@@ -324,12 +358,12 @@ impl DepthMap {
                 // The four points in light space.
                 let [x, y, z, w] = [0, 1, 2, 3].map(|c| f32x4::splat(l0[c]) + f32x4::splat(dl[c]) * t);
                 let (px, py, threshold) = match self.proj {
-                    // `Z_map + b0 < z` means shadow, that is `1/Z_map > 1/(z − b0)` with
-                    // `z = Z/w`; the slope term is added in nearness: the threshold is
-                    // `w / (Z − b0·w) + bs`. A point behind the light, or within the bias of
+                    // `Z_map + b0 + b1·z < z` means shadow, that is `1/Z_map > 1/(z(1 − b1)
+                    // − b0)` with `z = Z/w`; the slope term is added in nearness: the
+                    // threshold is `w / (Z(1 − b1) − b0·w) + bs`. A point behind the light, or within the bias of
                     // it, is lit: it goes far outside the map.
                     Projection::Perspective(_) => {
-                        let denom = z - w * b0;
+                        let denom = z * (1.0 - b1) - w * b0;
                         let ahead = z.simd_gt(0.0) & denom.simd_gt(0.0);
                         let q = f32x4::ONE / z;
                         let far = f32x4::splat(f32::NEG_INFINITY);
@@ -483,6 +517,13 @@ impl LightMaps {
                 )
             })
             .collect();
+        // What a map's window must cover: the whole scene, or (fitted) only the points the
+        // camera sees. A caster that shadows a seen point lies on that point's way to the
+        // light, inside the same window (the same strip of an orthographic map, the same cone
+        // from a point light), so the fitted map loses nothing and spends its texels on what
+        // is seen. Depth still spans the whole scene.
+        let seen = if o.fit_to_view { visible_points(ctx) } else { Vec::new() };
+        let covered = if seen.is_empty() { &corners } else { &seen };
         let near = 1e-6 * ctx.extent;
         let pinhole = |eye: DVec3, axis: DVec3, up: DVec3, fov: f64| {
             let up = if axis.cross(up).length() < 1e-6 { axis.any_orthonormal_vector() } else { up };
@@ -514,12 +555,10 @@ impl LightMaps {
                 counters.add("maps_ortho", 1);
                 let u = across(d);
                 let v = d.cross(u);
-                let range = |a: DVec3| {
-                    corners
-                        .iter()
-                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| (l.min(c.dot(a)), h.max(c.dot(a))))
+                let range = |pts: &[DVec3], a: DVec3| {
+                    pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| (l.min(c.dot(a)), h.max(c.dot(a))))
                 };
-                let ((u0, u1), (v0, v1), (s0, _)) = (range(u), range(v), range(d));
+                let ((u0, u1), (v0, v1), (s0, _)) = (range(covered, u), range(covered, v), range(&corners, d));
                 let side = (u1 - u0).max(v1 - v0) * 1.01 + 1e-12;
                 let proj = Projection::Ortho {
                     u,
@@ -533,9 +572,10 @@ impl LightMaps {
                 LightMaps::Single(Box::new(DepthMap::render(ctx, proj, sample, o)))
             }
             LightSample::Point(s) => {
-                let center = (lo + hi) * 0.5;
+                let (clo, chi) = covered.iter().fold((covered[0], covered[0]), |(l, h), &p| (l.min(p), h.max(p)));
+                let center = (clo + chi) * 0.5;
                 let axis = (center - s).normalize_or(DVec3::NEG_Y);
-                let half = corners
+                let half = covered
                     .iter()
                     .map(|c| (*c - s).normalize_or(axis).dot(axis).clamp(-1.0, 1.0).acos())
                     .fold(0.0, f64::max);
@@ -603,7 +643,7 @@ impl<'a> Williams<'a> {
         let options = ctx.options.williams.clone();
         options.check()?;
         Self::check_memory(ctx, &options)?;
-        let bias = options.bias.unwrap_or(1e-3 * ctx.extent);
+        let bias = options.bias.unwrap_or(0.0);
         let samples: Vec<_> = ctx.all_samples().collect();
         let maps = samples.iter().map(|&(_, _, s)| LightMaps::new(ctx, s, &options, counters)).collect();
         counters.add("map_texels", (options.map_size as u64).pow(2));
@@ -665,6 +705,8 @@ impl<'a> Williams<'a> {
         let normal = if dist >= 0.0 { plane.n } else { -plane.n };
         let bias = Bias {
             constant: self.bias,
+            // Without a constant in world units, one texel of depth at the point.
+            texels: if self.options.bias.is_some() { 0.0 } else { 1.0 },
             slope: self.options.slope_bias,
             plane: *plane,
             offset: self.options.normal_offset,
