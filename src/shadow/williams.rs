@@ -575,10 +575,13 @@ impl LightMaps {
                 let (clo, chi) = covered.iter().fold((covered[0], covered[0]), |(l, h), &p| (l.min(p), h.max(p)));
                 let center = (clo + chi) * 0.5;
                 let axis = (center - s).normalize_or(DVec3::NEG_Y);
+                // The widest angle from the axis: the smallest cosine, one arccosine.
                 let half = covered
                     .iter()
-                    .map(|c| (*c - s).normalize_or(axis).dot(axis).clamp(-1.0, 1.0).acos())
-                    .fold(0.0, f64::max);
+                    .map(|c| (*c - s).normalize_or(axis).dot(axis))
+                    .fold(1.0, f64::min)
+                    .clamp(-1.0, 1.0)
+                    .acos();
                 if half < 80f64.to_radians() {
                     counters.add("maps_perspective", 1);
                     let proj = pinhole(s, axis, across(axis).cross(axis), (2.0 * half).to_degrees() * 1.02 + 0.1);
