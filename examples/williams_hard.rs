@@ -16,6 +16,7 @@ fn main() {
         let williams = WilliamsOptions {
             slope_bias: var("SLOPE").unwrap_or(d.slope_bias),
             normal_offset: var("NORMAL").unwrap_or(d.normal_offset),
+            receiver_plane: var("RPDB").is_some_and(|f| f != 0.0),
             fit_to_view: var("FIT").map_or(d.fit_to_view, |f| f != 0.0),
             map_size: var("MAP").map_or(d.map_size, |m| m as u32),
             ..d

@@ -71,6 +71,10 @@ struct ShadowArgs {
     /// (normal-offset shadows; 0 is off).
     #[arg(long, default_value_t = 2.0)]
     normal_offset: f64,
+    /// Williams: receiver-plane depth bias: compare each PCF texel with the receiver's plane
+    /// extrapolated to it.
+    #[arg(long)]
+    receiver_plane: bool,
     /// Williams: nearest (one texel), pcf (percentage-closer filtering over --pcf-size²
     /// texels), or soft-edge (seed 002: PCF into a screen buffer, then a 15-tap Gaussian blur).
     #[arg(long, value_enum, default_value = "pcf")]
@@ -102,6 +106,7 @@ impl ShadowArgs {
                 bias: self.bias,
                 slope_bias: self.slope_bias,
                 normal_offset: self.normal_offset,
+                receiver_plane: self.receiver_plane,
                 filter,
                 cull_front: self.cull_front,
                 fit_to_view: !self.no_fit,

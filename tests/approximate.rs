@@ -226,3 +226,22 @@ fn shadows_stay_attached_at_grazing_contact() {
     eprintln!("slope bias: {} detached; normal offset: {} of {wrong} far from edges", detached.len(), far.len());
     assert!(far.len() < 50, "{} of {wrong} wrong pixels lie more than 3 pixels from a shadow edge", far.len());
 }
+
+/// Receiver-plane depth bias (an option): each PCF texel is compared with the receiver's
+/// plane extrapolated to it, which on the Cornell room removes the acne that one texel of
+/// constant bias alone leaves (measured: 34.8% of interior pixels wrong without it, 0.01%
+/// with it).
+#[test]
+fn receiver_plane_depth_bias_removes_acne() {
+    let scene = example("cornell.toml");
+    let want = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::RayCast);
+    let share = |receiver_plane: bool| {
+        let williams = WilliamsOptions { normal_offset: 0.0, receiver_plane, ..WilliamsOptions::default() };
+        let options = ShadowOptions { williams, ..ShadowOptions::default() };
+        let got = frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams, options);
+        let (interior, wrong, _) = umbra::study::compare::diff(&want, &got);
+        wrong as f64 / interior as f64
+    };
+    let (without, with) = (share(false), share(true));
+    assert!(without > 0.1 && with < 0.005, "{:.2}% without, {:.3}% with", 100.0 * without, 100.0 * with);
+}

@@ -61,6 +61,9 @@ pub struct WilliamsOptions {
     /// Normal offset (Holbert 2011): each lookup point is moved along the receiver's normal,
     /// toward the light's side, by this many of the map's texels at its depth (0: off).
     pub normal_offset: f64,
+    /// Receiver-plane depth bias (Isidoro 2006): compare each texel of the filter's kernel
+    /// with the receiver's plane extrapolated to it, not with the point's own depth.
+    pub receiver_plane: bool,
     /// Filter.
     pub filter: ShadowFilter,
     /// Leave out polygons facing the light in pass 1 (seed 003).
@@ -80,6 +83,7 @@ impl Default for WilliamsOptions {
             bias: None,
             slope_bias: 0.0,
             normal_offset: 2.0,
+            receiver_plane: false,
             filter: ShadowFilter::Pcf(3),
             cull_front: false,
             fit_to_view: true,
@@ -246,6 +250,8 @@ struct Bias {
     /// The normal offset in texels, and the receiver's normal turned to the light's side.
     offset: f64,
     normal: DVec3,
+    /// Compare each kernel texel with the receiver's plane extrapolated to it.
+    receiver_plane: bool,
 }
 
 /// Texels added to each row of a map: rows a power of two apart would otherwise share
@@ -343,8 +349,10 @@ impl DepthMap {
         let (l0, dl) = (at(h0), at(step));
         // The slope-scaled term, in nearness: how much the receiver's own nearness changes
         // over the texels the kernel reaches (r + ½ each way, rounded up to r + 1).
-        let slope = self.proj.depth_plane(&bias.plane).map_or(0.0, |d| d.a.abs() + d.b.abs());
+        let plane = self.proj.depth_plane(&bias.plane);
+        let slope = plane.map_or(0.0, |d| d.a.abs() + d.b.abs());
         let (b0, bs) = (bias.constant as f32, (bias.slope * slope * (r + 1) as f64) as f32);
+        let receiver_plane = bias.receiver_plane.then(|| plane.map_or((0.0, 0.0), |d| (d.a as f32, d.b as f32)));
         // The constant in texels of depth: relative to the depth for a perspective map
         // (`b1`), absolute for an orthographic one (folded into `b0`).
         let (b0, b1) = match &self.proj {
@@ -378,7 +386,42 @@ impl DepthMap {
                 };
                 batch.put(g, px, py, threshold, r, self.size);
             }
-            self.filter(batch, r, out);
+            match receiver_plane {
+                Some(gradient) => self.filter_receiver_plane(batch, r, gradient, out),
+                None => self.filter(batch, r, out),
+            }
+        }
+    }
+
+    /// Receiver-plane depth bias (Isidoro 2006): each texel of the kernel is compared with
+    /// the receiver's plane extrapolated to that texel's centre, `threshold + a·dx + b·dy`
+    /// (`(a, b)` the receiver's nearness gradient in texels, `(dx, dy)` from the point to the
+    /// texel's centre), so a wide kernel needs no slope allowance. Texels outside the map
+    /// count as lit.
+    fn filter_receiver_plane(&self, batch: &Located, r: usize, (a, b): (f32, f32), out: &mut [f32]) {
+        let (n, stride) = (self.size as i64, (self.size + PAD) as usize);
+        let width = 2 * r + 1;
+        let share = 1.0 / (width * width) as f32;
+        let len = out.len();
+        let (xs, ys) = (&batch.x.as_flattened()[..len], &batch.y.as_flattened()[..len]);
+        let thresholds = &batch.threshold.as_flattened()[..len];
+        for (k, o) in out.iter_mut().enumerate() {
+            let (x, y, t) = (xs[k], ys[k], thresholds[k]);
+            if !(x.is_finite() && y.is_finite()) {
+                *o = 1.0; // behind the light, or within the bias of it
+                continue;
+            }
+            let (cx, cy) = (x.floor() as i64, y.floor() as i64);
+            let r = r as i64;
+            let mut lit = 0u32;
+            for ty in cy - r..=cy + r {
+                for tx in cx - r..=cx + r {
+                    let inside = (0..n).contains(&tx) && (0..n).contains(&ty);
+                    let receiver = t + a * (tx as f32 + 0.5 - x) + b * (ty as f32 + 0.5 - y);
+                    lit += u32::from(!inside || self.nearness[ty as usize * stride + tx as usize] <= receiver);
+                }
+            }
+            *o = lit as f32 * share;
         }
     }
 
@@ -714,6 +757,7 @@ impl<'a> Williams<'a> {
             plane: *plane,
             offset: self.options.normal_offset,
             normal,
+            receiver_plane: self.options.receiver_plane,
         };
         let map = &self.maps[self.ctx.sample_index(light, s)];
         map.lit_run(h0 * flip, step * flip, &bias, self.kernel_radius(), batch, out);
