@@ -28,6 +28,9 @@ enum Command {
     /// Render a scene with every visibility × shadow combination, measure each against the
     /// ray-cast reference, and write report.html, results.json and results.csv.
     Compare(CompareArgs),
+    /// Time each method on one scene: warm-up frames, then timed frames in one process; the
+    /// median, least and greatest of the frame and of every phase, and the peak memory.
+    Bench(BenchArgs),
     /// Sweep a generated scene family over a parameter and plot time and a counter.
     Scale(ScaleArgs),
     /// Show what Watkins' algorithm and a shadow stage did on one scanline.
@@ -174,6 +177,32 @@ struct CompareArgs {
     /// Timed runs per method; the median is reported.
     #[arg(long, default_value_t = 3)]
     runs: usize,
+    #[command(flatten)]
+    shadow: ShadowArgs,
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// Comma-separated visibility stages (one row per visibility × shadow pair).
+    #[arg(long, value_delimiter = ',', value_parser = parse::<VisibilityMethod>, default_value = "scanline")]
+    visibility: Vec<VisibilityMethod>,
+    /// Comma-separated shadow stages.
+    #[arg(long, value_delimiter = ',', value_parser = parse::<ShadowMethod>, default_value = ShadowMethod::DEFAULT.name())]
+    shadows: Vec<ShadowMethod>,
+    /// Timed frames per method.
+    #[arg(long, default_value_t = 7)]
+    runs: usize,
+    /// Untimed frames first, per method.
+    #[arg(long, default_value_t = 2)]
+    warmup: usize,
+    /// Threads to render with (default: one per core).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// One JSON object per row instead of a table.
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     shadow: ShadowArgs,
 }
@@ -364,6 +393,37 @@ fn run(cli: Cli) -> umbra::Result<()> {
             }
             eprintln!("report: {}", a.out.join("report.html").display());
             Ok(())
+        }
+        Command::Bench(a) => {
+            let scene = Scene::load(&a.scene)?;
+            let opts = umbra::study::bench::BenchOptions {
+                visibility: a.visibility,
+                shadows: a.shadows,
+                shadow_options: a.shadow.options(false)?,
+                warmup: a.warmup,
+                runs: a.runs,
+            };
+            let threads = a.threads.unwrap_or(0);
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .map_err(|e| Error::Invalid(format!("cannot start {threads} threads: {e}")))?;
+            let rows = pool.install(|| {
+                umbra::study::bench::bench(&scene, &opts, |what| {
+                    use std::io::Write;
+                    let _ = writeln!(std::io::stderr(), "bench: {what}");
+                })
+            })?;
+            if a.json {
+                let mut text = String::new();
+                for r in &rows {
+                    text += &serde_json::to_string(r).map_err(|e| Error::Internal(e.to_string()))?;
+                    text.push('\n');
+                }
+                stdout(&text)
+            } else {
+                stdout(&umbra::study::bench::table(&rows))
+            }
         }
         Command::Scale(a) => {
             let methods = if a.methods.is_empty() {

@@ -194,3 +194,32 @@ fn work_beyond_the_memory_budget_is_refused_before_it_starts() {
     .unwrap();
     refused(&["render", area.to_str().unwrap(), "-o", "/dev/null", "--shadows", "williams"], "memory budget");
 }
+
+/// `bench` times each visibility × shadow pair with warm-up in one process and reports the
+/// frame's and each phase's median, least and greatest time and the peak memory, as one JSON
+/// object per row.
+#[test]
+fn bench_reports_spread_phases_and_memory() {
+    let out = umbra()
+        .args(["bench", SMALL, "--visibility", "scanline,zbuffer", "--shadows", "none,crow", "--runs", "3"])
+        .args(["--warmup", "1", "--threads", "2", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows: Vec<serde_json::Value> =
+        String::from_utf8_lossy(&out.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(rows.len(), 4);
+    for r in &rows {
+        let (min, median, max) =
+            (r["min_ms"].as_f64().unwrap(), r["median_ms"].as_f64().unwrap(), r["max_ms"].as_f64().unwrap());
+        assert!(0.0 < min && min <= median && median <= max, "{r}");
+        for phase in ["view", "visibility", "shadow_prepare", "shading"] {
+            assert!(r["phases"][phase]["median_ms"].as_f64().is_some(), "{phase} missing in {r}");
+        }
+        assert!(r["peak_rss_mb"].as_f64().unwrap() > 1.0, "{r}");
+        assert_eq!(r["runs"], 3);
+    }
+    assert_eq!(rows[3]["visibility"], "zbuffer");
+    assert_eq!(rows[3]["shadows"], "crow");
+    refused(&["bench", SMALL, "--runs", "0"], "at least one timed run");
+}
