@@ -82,6 +82,22 @@ impl Frame {
         Self::ids_image(&self.id, self.width, self.height)
     }
 
+    /// `id_view.png`: the face ids in false colour for looking at (`id.png` packs each id
+    /// into RGBA bytes, which image viewers show as nearly black): each face its own colour,
+    /// background black.
+    pub fn id_view_image(&self) -> image::RgbImage {
+        image::RgbImage::from_fn(self.width, self.height, |x, y| {
+            let id = self.id[(y * self.width + x) as usize];
+            if id == BACKGROUND {
+                return image::Rgb([0, 0, 0]);
+            }
+            // A multiplicative hash spreads neighbouring ids over the colours.
+            let h = id.wrapping_add(1).wrapping_mul(0x9E37_79B9);
+            let [r, g, b, _] = h.to_be_bytes();
+            image::Rgb([r | 0x30, g | 0x30, b | 0x30])
+        })
+    }
+
     fn ids_image(ids: &[u32], width: u32, height: u32) -> image::RgbaImage {
         image::RgbaImage::from_fn(width, height, |x, y| image::Rgba(ids[(y * width + x) as usize].to_le_bytes()))
     }
@@ -145,6 +161,7 @@ impl Frame {
     pub fn save_aovs(&self, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|e| Error::Io { path: dir.to_owned(), source: e })?;
         self.save(self.id_image().into(), &dir.join("id.png"))?;
+        self.save(self.id_view_image().into(), &dir.join("id_view.png"))?;
         for k in 0..self.light.len() {
             if let Some(img) = self.light_image(k) {
                 self.save(img.into(), &dir.join(format!("light{k}.png")))?;

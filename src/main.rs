@@ -297,6 +297,9 @@ struct GenerateArgs {
     /// Where to write the scene file; meshes go to meshes/ beside it.
     #[arg(short, long)]
     output: PathBuf,
+    /// Overwrite files that exist.
+    #[arg(long)]
+    force: bool,
     /// Cubes per side (cubes).
     #[arg(long, default_value_t = 10)]
     n: u32,
@@ -330,6 +333,9 @@ struct ExportArgs {
     /// Which light (0-based, in file order).
     #[arg(long, default_value_t = 0)]
     light: usize,
+    /// Overwrite the OBJ file if it exists.
+    #[arg(long)]
+    force: bool,
 }
 
 fn parse<T: std::str::FromStr<Err = Error>>(s: &str) -> Result<T, String> {
@@ -349,6 +355,19 @@ fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
             check_png_name(&a.output)?;
+            let drawn = [
+                ShadowMethod::BouknightKelley,
+                ShadowMethod::AthertonWeilerGreenberg,
+                ShadowMethod::Crow,
+                ShadowMethod::Planar,
+            ];
+            if a.debug.is_some() && !drawn.contains(&a.shadows) {
+                return Err(Error::Invalid(format!(
+                    "--debug shadow-polygons draws the polygons of bouknight-kelley, atherton-weiler-greenberg, crow \
+                     and planar; {} has none to draw",
+                    a.shadows
+                )));
+            }
             let scene = Scene::load(&a.scene)?;
             let opts = RenderOptions {
                 visibility: a.visibility,
@@ -476,9 +495,12 @@ fn run(cli: Cli) -> umbra::Result<()> {
                     scene.lights().len()
                 )));
             }
+            refuse_overwrite(std::slice::from_ref(&e.output), e.force)?;
             let mut counters = umbra::Counters::default();
             let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, &mut counters)?;
-            db.write_obj(&scene, &e.output)
+            db.write_obj(&scene, &e.output)?;
+            let polygons: usize = db.samples.iter().map(Vec::len).sum();
+            say(&format!("wrote {}: {polygons} lit detail polygon(s) of light {}", e.output.display(), e.light))
         }
         Command::Generate(g) => {
             let scene = match g.family {
@@ -486,9 +508,36 @@ fn run(cli: Cli) -> umbra::Result<()> {
                 Family::Quads => generate::stacked_quads(g.depth, g.width, g.height)?,
                 Family::Spheres => generate::spheres(g.triangles, g.count, g.width, g.height)?,
             };
-            scene.write(&g.output)
+            let dir = g.output.parent().unwrap_or(std::path::Path::new("")).join("meshes");
+            let stem = g.output.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+            let meshes: Vec<PathBuf> =
+                (0..scene.objects().len()).map(|i| dir.join(format!("{stem}_{i}.obj"))).collect();
+            refuse_overwrite(&[&[g.output.clone()][..], &meshes].concat(), g.force)?;
+            scene.write(&g.output)?;
+            say(&format!(
+                "wrote {} ({} polygons) and {} mesh(es) in {}",
+                g.output.display(),
+                scene.polygons().len(),
+                meshes.len(),
+                dir.display()
+            ))
         }
     }
+}
+
+/// Refuses to write over files that exist, unless told to (`--force`).
+fn refuse_overwrite(paths: &[PathBuf], force: bool) -> umbra::Result<()> {
+    match paths.iter().find(|p| p.exists()) {
+        Some(p) if !force => Err(Error::Invalid(format!("{}: exists; pass --force to overwrite it", p.display()))),
+        _ => Ok(()),
+    }
+}
+
+/// A line about what was done, on standard error (standard output stays for data).
+fn say(line: &str) -> umbra::Result<()> {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "{line}");
+    Ok(())
 }
 
 /// Writes `text` to standard output; a failed write (a closed pipe, a full disk) is an error.

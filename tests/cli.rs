@@ -223,3 +223,38 @@ fn bench_reports_spread_phases_and_memory() {
     assert_eq!(rows[3]["shadows"], "crow");
     refused(&["bench", SMALL, "--runs", "0"], "at least one timed run");
 }
+
+/// Commands that write files say what they wrote and refuse to overwrite without `--force`;
+/// `--debug shadow-polygons` is refused where the stage has no polygons to draw; `--aov`
+/// writes a viewable face-id image beside the packed one.
+#[test]
+fn nothing_silent() {
+    let d = tmp("silent");
+    let g = d.join("g.toml");
+    let gen = ["generate", "cubes", "--n", "1", "--width", "32", "--height", "24", "-o", g.to_str().unwrap()];
+    let (ok, err) = run(&gen);
+    assert!(ok && err.contains("wrote") && err.contains("g.toml"), "{err}");
+    refused(&gen, "exists; pass --force");
+    let (ok, err) = run(&[&gen[..], &["--force"]].concat());
+    assert!(ok, "{err}");
+    let obj = d.join("lit.obj");
+    let export = ["export-shadows", SMALL, "-o", obj.to_str().unwrap()];
+    let (ok, err) = run(&export);
+    assert!(ok && err.contains("wrote") && err.contains("lit detail polygon"), "{err}");
+    refused(&export, "exists; pass --force");
+    for s in ["williams", "ray-cast", "none", "stencil-volume"] {
+        refused(
+            &["render", SMALL, "-o", "/dev/null", "--shadows", s, "--debug", "shadow-polygons"],
+            "has none to draw",
+        );
+    }
+    let aov = d.join("aov");
+    let (ok, err) = run(&["render", SMALL, "-o", "/dev/null", "--aov", aov.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let view = image::open(aov.join("id_view.png")).unwrap().to_rgb8();
+    let packed = image::open(aov.join("id.png")).unwrap().to_rgba8();
+    // Background black, faces bright: every pixel with a face shows it.
+    for (v, p) in view.pixels().zip(packed.pixels()) {
+        assert_eq!(p.0 == [255; 4], v.0 == [0, 0, 0]);
+    }
+}

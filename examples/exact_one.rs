@@ -1,0 +1,28 @@
+//! Pixels where one shadow stage differs from ray-cast on a scene, and how many of those are
+//! ties: `cargo run --release --example exact_one -- scene.toml crow [zfail]`.
+use umbra::shadow::volumes::Counting;
+use umbra::shadow::ShadowOptions;
+use umbra::{render, RenderOptions, Scene, ShadowMethod};
+
+fn main() {
+    let a: Vec<String> = std::env::args().collect();
+    let scene = Scene::load(&a[1]).unwrap();
+    let method: ShadowMethod = a[2].parse().unwrap();
+    let crow_count = if a.get(3).is_some_and(|c| c == "zfail") { Counting::ZFail } else { Counting::ZPass };
+    let go =
+        |s, o| render(&scene, &RenderOptions { shadows: s, shadow_options: o, ..Default::default() }).unwrap().frame;
+    let want = go(ShadowMethod::RayCast, ShadowOptions::default());
+    let got = go(method, ShadowOptions { crow_count, ..Default::default() });
+    let oracle = umbra::reference::Reference::new(&scene);
+    let (mut differ, mut ties) = (0, 0);
+    for y in 0..want.height {
+        for x in 0..want.width {
+            let k = (y * want.width + x) as usize;
+            if want.id[k] != got.id[k] || want.light.iter().zip(&got.light).any(|(p, q)| p[k] != q[k]) {
+                differ += 1;
+                ties += usize::from(oracle.is_tie(x, y));
+            }
+        }
+    }
+    println!("{} pixels, {differ} differ from ray-cast, {ties} of them ties", want.id.len());
+}
