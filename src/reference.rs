@@ -16,6 +16,7 @@
 
 use crate::bvh::Bvh;
 use crate::scene::{LightSample, Scene};
+use crate::shadow::blocked;
 use crate::view::View;
 
 /// How far (in pixels) a sample point moves to test for a tie.
@@ -87,28 +88,15 @@ impl<'a> Reference<'a> {
         };
         let polygon = &self.scene.polygons[poly as usize];
         let p = self.view.point_on(&polygon.plane, x, y);
-        let eps = 1e-9;
         let lit = self
             .samples
             .iter()
             .map(|samples| {
                 let reached = samples
                     .iter()
-                    .filter(|s| {
+                    .filter(|&&s| {
                         s.on_seen_side(&polygon.plane, self.view.eye)
-                            && !match **s {
-                                LightSample::Point(l) => {
-                                    self.casters.occluded(self.scene, p, l - p, eps, 1.0 - eps, polygon.face)
-                                }
-                                LightSample::Directional(dir) => self.casters.occluded(
-                                    self.scene,
-                                    p,
-                                    -dir,
-                                    eps * self.extent,
-                                    f64::INFINITY,
-                                    polygon.face,
-                                ),
-                            }
+                            && !blocked(&self.casters, self.scene, p, s, polygon.face, self.extent)
                     })
                     .count();
                 reached as f32 / samples.len() as f32

@@ -21,6 +21,7 @@ pub use atherton_weiler_greenberg::{AthertonWeilerGreenberg, ShadowDatabase};
 pub use bouknight_kelley::BouknightKelley;
 pub use crow::Crow;
 pub use planar::Planar;
+pub(crate) use ray_cast::blocked;
 pub use ray_cast::RayCastShadows;
 pub use stencil_volume::StencilVolume;
 pub use williams::{MapStorage, ShadowFilter, Williams, WilliamsOptions};

@@ -4,9 +4,22 @@
 
 use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::bvh::Bvh;
-use crate::scene::LightSample;
+use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::visibility::Run;
+use glam::DVec3;
+
+/// Whether a casting polygon of `casters` other than face `face` crosses the open segment
+/// from `p` to the light sample (section 3's lit rule, the same-side test aside): ends within
+/// a relative 1e-9 of `p` or of the light do not count; for a directional light the ray
+/// starts 1e-9 of the scene's size `extent` from `p`.
+pub(crate) fn blocked(casters: &Bvh, scene: &Scene, p: DVec3, sample: LightSample, face: u32, extent: f64) -> bool {
+    let eps = 1e-9;
+    match sample {
+        LightSample::Point(s) => casters.occluded(scene, p, s - p, eps, 1.0 - eps, face),
+        LightSample::Directional(d) => casters.occluded(scene, p, -d, eps * extent, f64::INFINITY, face),
+    }
+}
 
 /// The prepared reference stage.
 pub struct RayCastShadows<'a> {
@@ -41,17 +54,11 @@ impl ShadowWalker for Walker<'_> {
         let ctx = self.stage.ctx;
         let poly = &ctx.scene.polygons[run.poly as usize];
         let yc = line as f64 + 0.5;
-        // Open segment: ends within a relative 1e-9 of P or of the light do not count.
-        let eps = 1e-9;
+        let s = ctx.samples[light][sample];
         for (i, out) in lit.iter_mut().enumerate() {
             let p = ctx.view.point_on(&poly.plane, (run.x0 + i as u32) as f64 + 0.5, yc);
-            let blocked = match ctx.samples[light][sample] {
-                LightSample::Point(s) => self.stage.bvh.occluded(ctx.scene, p, s - p, eps, 1.0 - eps, poly.face),
-                LightSample::Directional(d) => {
-                    self.stage.bvh.occluded(ctx.scene, p, -d, eps * ctx.extent, f64::INFINITY, poly.face)
-                }
-            };
-            *out = if blocked { 0.0 } else { 1.0 };
+            let shadowed = blocked(&self.stage.bvh, ctx.scene, p, s, poly.face, ctx.extent);
+            *out = if shadowed { 0.0 } else { 1.0 };
         }
         self.rays += lit.len() as u64;
         self.last = (run.x0, run.x1);
