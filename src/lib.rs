@@ -40,6 +40,7 @@ pub mod error;
 pub mod frame;
 pub mod generate;
 pub mod geometry;
+mod progress;
 pub mod reference;
 pub mod reflection;
 pub mod render;

@@ -14,9 +14,7 @@ use crate::stats::{Counters, Stats};
 use crate::view::View;
 use crate::visibility::VisibilityMethod;
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
-use std::io::IsTerminal;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -170,7 +168,9 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
             tests: test_rows.as_mut().and_then(|rows| rows.next()),
         })
         .collect();
-    let progress = Mutex::new(Progress::new(opts.progress, h as u64));
+    let mut bar = crate::progress::Bar::new(opts.progress, h as u64, "{msg} {bar:40} {pos}/{len} lines {elapsed}");
+    bar.set_message("rendering");
+    let progress = Mutex::new(bar);
     let counters: Vec<Counters> = jobs
         .into_par_iter()
         .map(|out| {
@@ -259,47 +259,5 @@ fn fin(x: f32) -> f32 {
         f32::MAX
     } else {
         x.clamp(-f32::MAX, f32::MAX)
-    }
-}
-
-/// A progress bar that appears only after a second, and only on a terminal.
-struct Progress {
-    bar: Option<ProgressBar>,
-    enabled: bool,
-    start: Instant,
-    done: u64,
-    total: u64,
-}
-
-impl Progress {
-    fn new(enabled: bool, total: u64) -> Self {
-        Progress {
-            bar: None,
-            enabled: enabled && std::io::stderr().is_terminal(),
-            start: Instant::now(),
-            done: 0,
-            total,
-        }
-    }
-
-    fn advance(&mut self, n: u64) {
-        self.done += n;
-        if self.bar.is_none() && self.enabled && self.start.elapsed() > Duration::from_secs(1) {
-            let bar = ProgressBar::with_draw_target(Some(self.total), ProgressDrawTarget::stderr());
-            if let Ok(style) = ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} lines {elapsed}") {
-                bar.set_style(style);
-            }
-            bar.set_message("rendering");
-            self.bar = Some(bar);
-        }
-        if let Some(bar) = &self.bar {
-            bar.set_position(self.done);
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
     }
 }

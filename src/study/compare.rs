@@ -152,10 +152,7 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
     let reference = render(scene, &reference_opts)?.frame;
     let reference_image = save(reference.color_image(None), "reference.png")?;
     let total = (opts.visibility.len() * opts.shadows.len() * opts.runs.max(1)) as u64;
-    let bar = if opts.progress { indicatif::ProgressBar::new(total) } else { indicatif::ProgressBar::hidden() };
-    if let Ok(style) = indicatif::ProgressStyle::with_template("{msg:32} {bar:40} {pos}/{len} renders {elapsed}") {
-        bar.set_style(style);
-    }
+    let mut bar = crate::progress::Bar::new(opts.progress, total, "{msg:32} {bar:40} {pos}/{len} renders {elapsed}");
     let mut results = Vec::new();
     for &v in &opts.visibility {
         for &s in &opts.shadows {
@@ -182,7 +179,7 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
                     }
                     Err(e) => return Err(e),
                 }
-                bar.inc(1);
+                bar.advance(1);
             }
             let times: Vec<f64> = runs.iter().map(|r| r.stats.time_ms.get("total").copied().unwrap_or(0.0)).collect();
             let med = median(&times);
@@ -229,7 +226,7 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
             });
         }
     }
-    bar.finish_and_clear();
+    bar.finish();
     let report = Report {
         scene: name.into(),
         width: scene.camera.width,

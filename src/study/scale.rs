@@ -10,9 +10,12 @@ use crate::render::{render, RenderOptions};
 use crate::scene::Scene;
 use crate::shadow::{ShadowMethod, ShadowOptions};
 use crate::visibility::VisibilityMethod;
+#[cfg(feature = "plots")]
 use plotters::prelude::*;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+#[cfg(feature = "plots")]
+use std::path::Path;
+use std::path::PathBuf;
 
 /// What is swept.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -129,7 +132,8 @@ pub struct Point {
     pub counter: u64,
 }
 
-/// Runs the sweep, writes `scale.csv`, `time.svg` and `counter.svg` into `out`.
+/// Runs the sweep, writes `scale.csv`, and with the `plots` feature (on by default)
+/// `time.svg` and `counter.svg`, into `out`.
 pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     std::fs::create_dir_all(&o.out).map_err(|e| Error::Io { path: o.out.clone(), source: e })?;
     let (kind, name) = o.counter.split_once('.').unwrap_or(("visibility", &o.counter));
@@ -187,12 +191,16 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     }
     let path = o.out.join("scale.csv");
     std::fs::write(&path, csv).map_err(|e| Error::Io { path, source: e })?;
-    plot(&o.out.join("time.svg"), o, &points, "time (ms)", |p| p.time_ms)?;
-    plot(&o.out.join("counter.svg"), o, &points, &o.counter, |p| p.counter as f64)?;
+    #[cfg(feature = "plots")]
+    {
+        plot(&o.out.join("time.svg"), o, &points, "time (ms)", |p| p.time_ms)?;
+        plot(&o.out.join("counter.svg"), o, &points, &o.counter, |p| p.counter as f64)?;
+    }
     Ok(points)
 }
 
 /// A log-log plot of `y` against the swept value, one line per method.
+#[cfg(feature = "plots")]
 fn plot(path: &Path, o: &ScaleOptions, points: &[Point], label: &str, y: impl Fn(&Point) -> f64) -> Result<()> {
     let err = |e: String| Error::Invalid(format!("{}: cannot draw the plot: {e}", path.display()));
     let xs = points.iter().map(|p| p.value);
