@@ -382,9 +382,12 @@ impl Adjacency {
                 .into_iter()
                 .flatten()
                 .any(|q| scene.polygons.get(q).is_some_and(|o| o.face == poly.face));
+            // Only a polygon of four or more corners can cross itself (most meshes are
+            // triangles: no ring is built for them).
             let axis = dominant_axis(poly.plane.n);
-            let ring: Vec<DVec2> = verts.iter().map(|&v| drop_axis(v, axis)).collect();
-            if even_odd::self_intersects(&ring) {
+            let ring = || verts.iter().map(|&v| drop_axis(v, axis)).collect::<Vec<DVec2>>();
+            let crossing = (verts.len() >= 4).then(ring).filter(|r| even_odd::self_intersects(r));
+            if let Some(ring) = crossing {
                 adjacency.keep_apart_even_odd(p, &ring, axis, &poly.plane);
             } else if !merge || fan_piece {
                 adjacency.apart.push(Apart { poly: p as u32, verts: verts.to_vec() });
