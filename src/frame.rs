@@ -229,10 +229,20 @@ pub fn check_gamma(gamma: f32) -> Result<()> {
 /// Encodes `img` as PNG in memory, then writes the file in one call, so that a failed write
 /// (a full disk, `/dev/full`) is an error and never a silently truncated file.
 pub(crate) fn write_png(img: image::DynamicImage, path: &Path) -> Result<()> {
+    let bytes = png_bytes(&img, path)?;
+    std::fs::write(path, bytes).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+}
+
+/// The image encoded as PNG, in memory.
+pub(crate) fn encode_png(img: &image::RgbImage) -> Result<Vec<u8>> {
+    png_bytes(&image::DynamicImage::ImageRgb8(img.clone()), Path::new("(in memory)"))
+}
+
+fn png_bytes(img: &image::DynamicImage, path: &Path) -> Result<Vec<u8>> {
     let mut bytes = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
         .map_err(|e| Error::Image { path: path.to_owned(), source: e })?;
-    std::fs::write(path, bytes).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+    Ok(bytes)
 }
 
 #[cfg(test)]

@@ -35,6 +35,11 @@ enum Command {
     Scale(ScaleArgs),
     /// Show what Watkins' algorithm and a shadow stage did on one scanline.
     Trace(TraceArgs),
+    /// Watch the algorithms work: a page in the browser, served on 127.0.0.1, that draws what
+    /// `trace` prints for any line and stage, with the frame, its counters and the pixels
+    /// where a stage differs from ray-cast.
+    #[cfg(feature = "explore")]
+    Explore(ExploreArgs),
     /// Write a generated benchmark scene (scene file plus OBJ meshes).
     Generate(GenerateArgs),
     /// Build the Atherton-Weiler-Greenberg shadow database of a light (its lit detail
@@ -264,6 +269,71 @@ struct TraceArgs {
     shadow: ShadowArgs,
 }
 
+#[cfg(feature = "explore")]
+#[derive(clap::Args)]
+struct ExploreArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// The port on 127.0.0.1 (0: any free port; the address is printed).
+    #[arg(long, default_value_t = 8470)]
+    port: u16,
+    /// Open the page in the default browser.
+    #[arg(long)]
+    open: bool,
+    /// Instead of serving, write the page with every line of every stage precomputed into
+    /// this folder (open its index.html from disk or put it on any static host).
+    #[arg(long)]
+    export: Option<PathBuf>,
+    /// The exported page's image size, WIDTHxHEIGHT (at most 640x480: every line of every
+    /// stage is stored).
+    #[arg(long, default_value = "240x180", value_parser = parse_size)]
+    size: (u32, u32),
+    /// Write into an --export folder that has files already.
+    #[arg(long)]
+    force: bool,
+}
+
+#[cfg(feature = "explore")]
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("'{s}' is not WIDTHxHEIGHT with each from 1 to 640 and 480");
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    match (w.parse::<u32>(), h.parse::<u32>()) {
+        (Ok(w @ 1..=640), Ok(h @ 1..=480)) => Ok((w, h)),
+        _ => Err(bad()),
+    }
+}
+
+#[cfg(feature = "explore")]
+fn explore(a: ExploreArgs) -> umbra::Result<()> {
+    use umbra::study::explore::{export, serve, Explorer};
+    let scene = Scene::load(&a.scene)?;
+    let name = a.scene.file_name().map_or_else(|| a.scene.display().to_string(), |n| n.to_string_lossy().into_owned());
+    let explorer = Explorer::new(scene, name);
+    if let Some(dir) = &a.export {
+        let used = std::fs::read_dir(dir).map(|mut d| d.next().is_some()).unwrap_or(false);
+        if used && !a.force {
+            return Err(Error::Invalid(format!("{}: has files; pass --force to write into it", dir.display())));
+        }
+        export(&explorer, dir, a.size.0, a.size.1, &ShadowMethod::ALL)?;
+        return say(&format!("wrote {}: open it in a browser", dir.join("index.html").display()));
+    }
+    serve(explorer, a.port, |address| {
+        let _ = say(&format!("umbra explore: {address} (Ctrl-C stops)"));
+        if a.open {
+            open_browser(address);
+        }
+    })
+}
+
+/// Asks the desktop to open `address`; says so when it cannot.
+#[cfg(feature = "explore")]
+fn open_browser(address: &str) {
+    let opener = if cfg!(target_os = "macos") { "open" } else { "xdg-open" };
+    if std::process::Command::new(opener).arg(address).spawn().is_err() {
+        let _ = say(&format!("could not run {opener}; open {address} yourself"));
+    }
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum FilterArg {
     /// One texel.
@@ -485,6 +555,8 @@ fn run(cli: Cli) -> umbra::Result<()> {
                 stdout(&t.text(&scene, a.x))
             }
         }
+        #[cfg(feature = "explore")]
+        Command::Explore(a) => explore(a),
         Command::ExportShadows(e) => {
             let scene = Scene::load(&e.scene)?;
             if e.light >= scene.lights().len() {

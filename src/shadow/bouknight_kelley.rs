@@ -34,7 +34,7 @@
 
 use super::overlay::{Interval, Overlay, OverlayWalker};
 use super::projection::{bounding_rectangle, edge_on, light_side, Projector};
-use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
+use super::{Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker};
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -307,7 +307,7 @@ impl ShadowStage for BouknightKelley<'_> {
             segments: 0,
             splits: 0,
             depth_max: 0,
-            last: (0, 0),
+            last: (0, 0, 0, 0),
         })
     }
 }
@@ -319,36 +319,29 @@ struct Walker<'s> {
     segments: u64,
     splits: u64,
     depth_max: u32,
-    /// Segments and splits of the last run.
-    last: (u64, u64),
+    /// The last run, and its segments and splits.
+    last: (u32, u32, u64, u64),
 }
 
-impl Walker<'_> {
-    /// Step 4 on segment `a..b` of a run starting at pixel `x0`: lit (1) or shadowed (0) into
-    /// `out[a - x0 .. b - x0]`, given the shadow polygons' intervals that may touch it.
-    fn segment(&mut self, a: u32, b: u32, candidates: &[Interval], depth: u32, x0: u32, out: &mut [f32]) {
-        self.segments += 1;
-        self.depth_max = self.depth_max.max(depth);
-        let touching: smallvec::SmallVec<[Interval; 8]> =
-            candidates.iter().copied().filter(|iv| iv.start < b && iv.end > a).collect();
-        let range = (a - x0) as usize..(b - x0) as usize;
-        // No shadow polygon touches the segment: normal (lit).
-        let Some(first) = touching.first() else {
-            out[range].fill(1.0);
-            return;
-        };
-        // One covers it fully: in shadow.
-        if touching.iter().any(|iv| iv.start <= a && iv.end >= b) {
-            out[range].fill(0.0);
-            return;
-        }
-        // One covers it partly: split at its edges and examine the parts.
-        self.splits += 1;
-        let cuts = [a, first.start.max(a), first.end.min(b), b];
-        for w in cuts.windows(2) {
-            if w[0] < w[1] {
-                self.segment(w[0], w[1], &touching, depth + 1, x0, out);
-            }
+/// Step 4 on segment `a..b`, given the shadow polygons' intervals that may touch it: calls
+/// `visit(a, b, depth, outcome)` for every segment examined, parents before their parts.
+fn examine(a: u32, b: u32, candidates: &[Interval], depth: u32, visit: &mut impl FnMut(u32, u32, u32, Outcome)) {
+    let touching: smallvec::SmallVec<[Interval; 8]> =
+        candidates.iter().copied().filter(|iv| iv.start < b && iv.end > a).collect();
+    // No shadow polygon touches the segment: normal (lit).
+    let Some(first) = touching.first() else {
+        return visit(a, b, depth, Outcome::Lit);
+    };
+    // One covers it fully: in shadow.
+    if touching.iter().any(|iv| iv.start <= a && iv.end >= b) {
+        return visit(a, b, depth, Outcome::Shadow);
+    }
+    // One covers it partly: split at its edges and examine the parts.
+    visit(a, b, depth, Outcome::Split);
+    let cuts = [a, first.start.max(a), first.end.min(b), b];
+    for w in cuts.windows(2) {
+        if w[0] < w[1] {
+            examine(w[0], w[1], &touching, depth + 1, visit);
         }
     }
 }
@@ -362,26 +355,42 @@ impl ShadowWalker for Walker<'_> {
 
     fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
         let k = self.stage.ctx.sample_index(light, sample);
-        let mut intervals = std::mem::take(&mut self.intervals);
-        self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut intervals);
-        let before = (self.segments, self.splits);
-        self.segment(run.x0, run.x1, &intervals, 0, run.x0, lit);
-        self.last = (self.segments - before.0, self.splits - before.1);
-        self.intervals = intervals;
+        self.walkers[k].intervals(run.poly, run.x0, run.x1, &mut self.intervals);
+        let (mut segments, mut splits, mut depth_max) = (0, 0, 0);
+        examine(run.x0, run.x1, &self.intervals, 0, &mut |a, b, depth, outcome| {
+            segments += 1;
+            depth_max = depth_max.max(depth);
+            let range = (a - run.x0) as usize..(b - run.x0) as usize;
+            match outcome {
+                Outcome::Lit => lit[range].fill(1.0),
+                Outcome::Shadow => lit[range].fill(0.0),
+                Outcome::Split => splits += 1,
+            }
+        });
+        self.segments += segments;
+        self.splits += splits;
+        self.depth_max = self.depth_max.max(depth_max);
+        self.last = (run.x0, run.x1, segments, splits);
     }
 
     fn decision(&self) -> Decision {
-        let on: Vec<String> =
-            self.intervals.iter().map(|i| format!("#{} covers {}..{}", i.tag, i.start, i.end)).collect();
+        let covers: Vec<Cover> =
+            self.intervals.iter().map(|i| Cover { polygon: i.tag, start: i.start, end: i.end }).collect();
+        let on: Vec<String> = covers.iter().map(|c| format!("#{} covers {}..{}", c.polygon, c.start, c.end)).collect();
+        let mut segments = Vec::new();
+        examine(self.last.0, self.last.1, &self.intervals, 0, &mut |start, end, depth, outcome| {
+            segments.push(Segment { start, end, depth, outcome })
+        });
         Decision {
             tested: self.intervals.iter().map(|i| (i.start, i.end, 1)).collect(),
             note: format!(
                 "{} shadow polygon(s) on this polygon touch the run [{}]; {} segment(s) examined, {} split(s)",
-                self.intervals.len(),
+                covers.len(),
                 on.join(", "),
-                self.last.0,
-                self.last.1
+                self.last.2,
+                self.last.3
             ),
+            detail: Detail::Segments { covers, segments },
         }
     }
 

@@ -26,7 +26,7 @@
 //! volume never counts for its own face.
 
 use super::volumes::{Adjacency, Counting, ScreenVolumes, NONE};
-use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
+use super::{CountAdd, Decision, Detail, ShadowContext, ShadowStage, ShadowWalker};
 use crate::scan::{boundary, ActiveEdges, EdgeTable};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -86,6 +86,7 @@ impl ShadowStage for Crow<'_> {
             events: Vec::new(),
             last_pieces: Vec::new(),
             last_counts: Vec::new(),
+            last_adds: Vec::new(),
             yc: 0.0,
             runs: 0,
             events_total: 0,
@@ -136,6 +137,8 @@ struct Walker<'s> {
     /// The last run's coverage pieces (polygon, start, end) and its counted pieces.
     last_pieces: Vec<(u32, u32, u32)>,
     last_counts: Vec<(u32, u32, i32)>,
+    /// What each piece added to the count over the last run.
+    last_adds: Vec<CountAdd>,
     yc: f64,
     runs: u64,
     events_total: u64,
@@ -193,11 +196,13 @@ impl ShadowWalker for Walker<'_> {
         // Events: where each covering polygon starts and stops counting.
         self.events.clear();
         self.last_counts.clear();
+        self.last_adds.clear();
         for &(t, s, e) in &pieces {
             if s >= e {
                 continue;
             }
             let p = &polys[t as usize];
+            let adds = &mut self.last_adds;
             // What polygon p adds to the count at pixel x (see `count_at`).
             let counts = |x: u32| {
                 let xc = x as f64 + 0.5;
@@ -208,6 +213,7 @@ impl ShadowWalker for Walker<'_> {
                 if a < z && c != 0 {
                     self.events.push((a, c));
                     self.events.push((z, -c));
+                    adds.push(CountAdd { polygon: t, start: a, end: z, add: c, near_cap: p.near_cap });
                 }
             };
             if first == last {
@@ -260,6 +266,7 @@ impl ShadowWalker for Walker<'_> {
                 self.events.len(),
                 counts.join(", ")
             ),
+            detail: Detail::Counts { adds: self.last_adds.clone(), counts: self.last_counts.clone() },
         }
     }
 

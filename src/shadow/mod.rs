@@ -146,6 +146,90 @@ pub struct Decision {
     pub tested: Vec<(u32, u32, u32)>,
     /// The stage's own account, in a line.
     pub note: String,
+    /// The same account as data, for drawing it (`umbra explore`).
+    pub detail: Detail,
+}
+
+/// What a stage looked at for one run, in the terms of its paper.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum Detail {
+    /// Nothing beyond the note.
+    #[default]
+    None,
+    /// Bouknight-Kelley: the shadow polygons on the run's polygon that touch the run, and
+    /// the scan segments examined, in the order of the recursion.
+    Segments {
+        /// Shadow polygons touching the run.
+        covers: Vec<Cover>,
+        /// Every segment examined.
+        segments: Vec<Segment>,
+    },
+    /// Atherton-Weiler-Greenberg: the lit detail polygons on the run's polygon that cover
+    /// pixels of the run.
+    Covers {
+        /// Detail polygons over the run.
+        covers: Vec<Cover>,
+    },
+    /// Crow: what each shadow polygon over the run adds to the count, and the count.
+    Counts {
+        /// Each shadow polygon's contribution over the pixels where it holds.
+        adds: Vec<CountAdd>,
+        /// The count along the run: `(start, end, count)`; lit where it is zero.
+        counts: Vec<(u32, u32, i32)>,
+    },
+}
+
+/// An overlay polygon (shadow polygon, detail polygon) covering pixels `start..end`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Cover {
+    /// The polygon, an index into the stage's outlines.
+    pub polygon: u32,
+    /// First pixel covered.
+    pub start: u32,
+    /// One past the last.
+    pub end: u32,
+}
+
+/// One scan segment Bouknight-Kelley examined.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Segment {
+    /// First pixel.
+    pub start: u32,
+    /// One past the last.
+    pub end: u32,
+    /// Depth of the recursion (0: the whole run).
+    pub depth: u32,
+    /// What was decided.
+    pub outcome: Outcome,
+}
+
+/// What became of a scan segment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Outcome {
+    /// No shadow polygon touches it: lit.
+    Lit,
+    /// One covers it fully: in shadow.
+    Shadow,
+    /// One covers it partly: split at that polygon's edges.
+    Split,
+}
+
+/// What one shadow-volume polygon adds to Crow's count over pixels `start..end`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct CountAdd {
+    /// The shadow polygon, an index into the stage's outlines.
+    pub polygon: u32,
+    /// First pixel.
+    pub start: u32,
+    /// One past the last.
+    pub end: u32,
+    /// +1 entering a volume, -1 leaving one (z-pass); the opposite behind the point (z-fail).
+    pub add: i32,
+    /// A near cap: part of the eye's own count.
+    pub near_cap: bool,
 }
 
 /// The shadow methods, chosen by name.

@@ -7,7 +7,7 @@
 //! where a visible run on it asks: for a run on receiver B, the walker gives the pixel
 //! intervals where each of B's overlay polygons covers the run.
 
-use super::{Decision, ShadowContext, ShadowWalker};
+use super::{Cover, Decision, Detail, ShadowContext, ShadowWalker};
 use crate::scan::{boundary, ActiveEdges, EdgeTable};
 use crate::visibility::Run;
 use glam::DVec2;
@@ -187,6 +187,9 @@ impl ShadowWalker for CoverWalker<'_> {
         Decision {
             tested: self.intervals.iter().map(|i| (i.start, i.end, 1)).collect(),
             note: format!("{} {}(s) on this polygon cover [{}]", self.intervals.len(), self.what, on.join(", ")),
+            detail: Detail::Covers {
+                covers: self.intervals.iter().map(|i| Cover { polygon: i.tag, start: i.start, end: i.end }).collect(),
+            },
         }
     }
 }

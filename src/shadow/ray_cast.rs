@@ -68,6 +68,7 @@ impl ShadowWalker for Walker<'_> {
         Decision {
             tested: vec![(self.last.0, self.last.1, 1)],
             note: format!("{} shadow ray(s)", self.last.1 - self.last.0),
+            detail: super::Detail::None,
         }
     }
 

@@ -104,6 +104,10 @@ impl ShadowWalker for Walker<'_> {
     }
 
     fn decision(&self) -> Decision {
-        Decision { tested: Vec::new(), note: "read from the stencil count rasterised in preparation".into() }
+        Decision {
+            tested: Vec::new(),
+            note: "read from the stencil count rasterised in preparation".into(),
+            detail: super::Detail::None,
+        }
     }
 }

@@ -858,7 +858,11 @@ impl ShadowWalker for Walker<'_> {
 
     fn decision(&self) -> Decision {
         let (a, b, texels) = self.last;
-        Decision { tested: vec![(a, b, texels)], note: format!("{} map lookup(s) of {texels} texel(s) each", b - a) }
+        Decision {
+            tested: vec![(a, b, texels)],
+            note: format!("{} map lookup(s) of {texels} texel(s) each", b - a),
+            detail: super::Detail::None,
+        }
     }
 
     fn finish(&mut self, counters: &mut Counters) {

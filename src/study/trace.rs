@@ -6,12 +6,13 @@
 use crate::error::{Error, Result};
 use crate::scan::ActiveEdges;
 use crate::scene::Scene;
-use crate::shadow::{Decision, ShadowContext, ShadowMethod, ShadowOptions};
+use crate::shadow::{Decision, ShadowContext, ShadowMethod, ShadowOptions, ShadowWalker};
 use crate::stats::Counters;
 use crate::view::View;
 use crate::visibility::{resolve, Run, ScanlineVisibility, SpanRecord, Visibility};
 use serde::Serialize;
 use std::fmt::Write as _;
+use std::ops::Range;
 
 /// An edge of the edge table.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -74,9 +75,30 @@ pub struct LineTrace {
 
 /// Traces line `line` of `scene` with scanline visibility and the shadow stage `shadows`.
 pub fn trace(scene: &Scene, line: u32, shadows: ShadowMethod, options: &ShadowOptions) -> Result<LineTrace> {
+    let mut out = None;
+    trace_lines(scene, line..line + 1, shadows, options, |t| {
+        out = Some(t);
+        Ok(())
+    })?;
+    out.ok_or_else(|| Error::Internal(format!("line {line} was not traced")))
+}
+
+/// Traces every line of `lines` in order, handing each to `emit`; the shadow stage is
+/// prepared once.
+pub fn trace_lines(
+    scene: &Scene,
+    lines: Range<u32>,
+    shadows: ShadowMethod,
+    options: &ShadowOptions,
+    mut emit: impl FnMut(LineTrace) -> Result<()>,
+) -> Result<()> {
     let view = View::new(&scene.camera);
-    if line >= view.height {
-        return Err(Error::Invalid(format!("line {line} is outside the image (height {})", view.height)));
+    if lines.end > view.height || lines.is_empty() {
+        return Err(Error::Invalid(format!(
+            "line {} is outside the image (height {})",
+            lines.end.saturating_sub(1).max(lines.start),
+            view.height
+        )));
     }
     let screen = view.screen_polygons(scene);
     let mut counters = Counters::default();
@@ -92,36 +114,54 @@ pub fn trace(scene: &Scene, line: u32, shadows: ShadowMethod, options: &ShadowOp
             dxdy: e.5,
         }
     };
-    let entering = vis.table().edges().filter(|e| e.1 == line).map(edge).collect();
-    let leaving = vis.table().edges().filter(|e| e.2 == line).map(edge).collect();
-    let mut aet = ActiveEdges::new(vis.table(), line..line + 1);
-    let active = aet.advance_to(line).iter().map(|c| (c.x, screen[c.tag as usize].poly)).collect();
-    let (mut spans, mut runs) = (Vec::new(), Vec::new());
-    vis.walk_recorded(line..line + 1, &mut |_, r, s| {
-        runs = r.to_vec();
-        spans = s.to_vec();
-    });
+    let (mut entering, mut leaving) = (vec![Vec::new(); lines.len()], vec![Vec::new(); lines.len()]);
+    for e in vis.table().edges() {
+        for (at, list) in [(e.1, &mut entering), (e.2, &mut leaving)] {
+            if lines.contains(&at) {
+                list[(at - lines.start) as usize].push(edge(e));
+            }
+        }
+    }
+    let mut visible = Vec::with_capacity(lines.len());
+    vis.walk_recorded(lines.clone(), &mut |_, r, s| visible.push((r.to_vec(), s.to_vec())));
 
     let frame_runs = resolve(&vis as &dyn Visibility, view.height, &mut counters);
     let ctx = ShadowContext::new(scene, &view, &frame_runs, options.clone());
     let stage = shadows.prepare(&ctx, &mut counters)?;
     let mut walker = stage.walker();
-    for y in 0..=line {
+    for y in 0..lines.start {
         walker.start_line(y);
     }
+    let mut aet = ActiveEdges::new(vis.table(), lines.clone());
+    let rows = visible.into_iter().zip(entering).zip(leaving);
+    for (line, (((runs, spans), entering), leaving)) in lines.zip(rows) {
+        walker.start_line(line);
+        let active = aet.advance_to(line).iter().map(|c| (c.x, screen[c.tag as usize].poly)).collect();
+        let decisions = decide(&ctx, walker.as_mut(), line, &runs);
+        emit(LineTrace { line, shadows: shadows.name().into(), entering, leaving, active, spans, runs, decisions })?;
+    }
+    Ok(())
+}
+
+/// The shadow stage's decision for every run of `line` and every light sample.
+fn decide(ctx: &ShadowContext, walker: &mut dyn ShadowWalker, line: u32, runs: &[Run]) -> Vec<ShadowTrace> {
     let mut decisions = Vec::new();
-    let mut lit = vec![0.0f32; view.width as usize];
-    for run in &runs {
-        let plane = &scene.polygons[run.poly as usize].plane;
+    let mut lit = vec![0.0f32; ctx.view.width as usize];
+    for run in runs {
+        let plane = &ctx.scene.polygons[run.poly as usize].plane;
         for (l, s, sample) in ctx.all_samples() {
             let lit = &mut lit[..(run.x1 - run.x0) as usize];
-            let asked = sample.on_seen_side(plane, view.eye);
+            let asked = sample.on_seen_side(plane, ctx.view.eye);
             let decision = if asked {
                 walker.lit(l, s, line, run, lit);
                 walker.decision()
             } else {
                 lit.fill(0.0);
-                Decision { tested: Vec::new(), note: "the light is behind the seen side: in shadow".into() }
+                Decision {
+                    tested: Vec::new(),
+                    note: "the light is behind the seen side: in shadow".into(),
+                    detail: Default::default(),
+                }
             };
             let mut pieces: Vec<(u32, u32, f32)> = Vec::new();
             for (i, &v) in lit.iter().enumerate() {
@@ -143,7 +183,7 @@ pub fn trace(scene: &Scene, line: u32, shadows: ShadowMethod, options: &ShadowOp
             });
         }
     }
-    Ok(LineTrace { line, shadows: shadows.name().into(), entering, leaving, active, spans, runs, decisions })
+    decisions
 }
 
 impl LineTrace {
