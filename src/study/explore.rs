@@ -382,6 +382,7 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
     };
     let (width, height) = (side("width", &width.to_string())?, side("height", &height.to_string())?);
     let mut frames = serde_json::Map::new();
+    let mut watkins = String::new();
     for &shadows in stages {
         let r = Request { shadows, width, height, light: None };
         let shown = match explorer.show(&r) {
@@ -390,16 +391,21 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
         };
         let name = shadows.name();
         write(&format!("frames/{name}.png"), &shown.png)?;
-        let scene = explorer.scene_for(&r)?;
-        let mut lines = String::new();
-        trace_lines(&scene, 0..height, shadows, &ShadowOptions::default(), |t| {
-            let json = serde_json::to_string(&t).map_err(|e| Error::Internal(e.to_string()))?;
-            let _ = writeln!(lines, "umbraLine({json});");
+        // The visibility part of a line is the same for every stage: written once.
+        let first = watkins.is_empty();
+        let mut decisions = String::new();
+        trace_lines(&explorer.scene_for(&r)?, 0..height, shadows, &ShadowOptions::default(), |mut t| {
+            let _ = writeln!(decisions, "umbraDecisions({:?}, {}, {});", name, t.line, to_json(&t.decisions)?);
+            if first {
+                t.decisions.clear();
+                let _ = writeln!(watkins, "umbraLine({});", to_json(&t)?);
+            }
             Ok(())
         })?;
-        write(&format!("lines/{name}.js"), lines.as_bytes())?;
+        write(&format!("lines/{name}.js"), decisions.as_bytes())?;
         frames.insert(name.into(), shown.summary.clone());
     }
+    write("lines/watkins.js", watkins.as_bytes())?;
     let mut scene = explorer.describe();
     scene["width"] = width.into();
     scene["height"] = height.into();
@@ -408,4 +414,9 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
     write("index.html", PAGE.replace("<!--static-->", r#"<script src="data.js"></script>"#).as_bytes())?;
     write("explore.js", SCRIPT.as_bytes())?;
     write("explore.css", STYLE.as_bytes())
+}
+
+/// `v` as JSON text, for the exported scripts.
+fn to_json(v: &impl Serialize) -> Result<String> {
+    serde_json::to_string(v).map_err(|e| Error::Internal(e.to_string()))
 }

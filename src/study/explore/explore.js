@@ -69,8 +69,10 @@ function loadScript(src) {
   });
 }
 
-// Called by the exported lines/<stage>.js, once per line.
-window.umbraLine = (t) => { (staticLines[t.shadows] ||= [])[t.line] = t; };
+// Called by the exported lines/watkins.js (a line's visibility, the same for every stage)
+// and lines/<stage>.js (the stage's decisions on a line).
+window.umbraLine = (t) => { (staticLines.watkins ||= [])[t.line] = t; };
+window.umbraDecisions = (stage, line, decisions) => { (staticLines[stage] ||= [])[line] = decisions; };
 
 async function getFrame() {
   if (!STATIC) return [await api("frame"), `api/image?${params()}`];
@@ -81,8 +83,10 @@ async function getFrame() {
 
 async function getTrace() {
   if (!STATIC) return api("trace", { line: state.line });
+  if (!staticLines.watkins) await loadScript("lines/watkins.js");
   if (!staticLines[state.stage]) await loadScript(`lines/${state.stage}.js`);
-  return staticLines[state.stage][state.line];
+  const t = staticLines.watkins[state.line];
+  return { ...t, shadows: state.stage, decisions: staticLines[state.stage][state.line] };
 }
 
 // --- control --------------------------------------------------------------------------------

@@ -1,0 +1,186 @@
+// The browser test of `umbra explore` (run by .ci/run):
+//
+//   node tests/browser/explore.test.mjs [UMBRA_BINARY]
+//
+// Starts the server on a free loopback port, drives Debian's headless Chromium through the page
+// with playwright-core, and checks that the page loads with no console error, that the active
+// edge table and runs it shows for a line are what `umbra trace --json` prints, that switching
+// the stage changes the panels, that moving the light re-renders, that bad requests get a JSON
+// error the page shows, that many requests at once are all answered, and that the exported
+// static page works from files. With SCREENSHOTS=DIR it saves the screenshots of docs/explore.md.
+
+import { chromium } from "playwright-core";
+import { spawn, execFileSync } from "node:child_process";
+import { mkdtempSync, rmSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join, resolve } from "node:path";
+import assert from "node:assert/strict";
+
+const umbra = resolve(process.argv[2] || "target/debug/umbra");
+const scene = resolve("scenes/cornell.toml");
+const shots = process.env.SCREENSHOTS;
+const LINE = 261;
+
+function startServer() {
+  const server = spawn(umbra, ["explore", scene, "--port", "0"], { stdio: ["ignore", "ignore", "pipe"] });
+  return new Promise((resolvePromise, reject) => {
+    let err = "";
+    const timer = setTimeout(() => reject(new Error(`no address from umbra explore: ${err}`)), 30000);
+    server.stderr.on("data", (chunk) => {
+      err += chunk;
+      const m = err.match(/http:\/\/127\.0\.0\.1:\d+\//);
+      if (m) { clearTimeout(timer); resolvePromise([server, m[0]]); }
+    });
+    server.on("exit", (code) => reject(new Error(`umbra explore exited (${code}): ${err}`)));
+  });
+}
+
+function trace(line, stage) {
+  const out = execFileSync(umbra, ["trace", scene, "--line", `${line}`, "--shadows", stage, "--json"]);
+  return JSON.parse(out.toString());
+}
+
+async function ready(page, line) {
+  if (line !== undefined) await page.waitForSelector(`#aet[data-line="${line}"]`, { timeout: 60000 });
+  await page.waitForSelector("body[data-state=ready]", { timeout: 60000 });
+}
+
+async function tableRows(page, id) {
+  return page.$$eval(`#${id} tr`, (rows) => rows.slice(1).map((r) => [...r.cells].map((c) => c.textContent)));
+}
+
+async function newPage(browser, errors) {
+  const page = await browser.newPage({ viewport: { width: 1500, height: 1100 } });
+  page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
+  page.on("pageerror", (e) => errors.push(String(e)));
+  return page;
+}
+
+async function checkLive(browser, url) {
+  const errors = [];
+  const page = await newPage(browser, errors);
+  await page.goto(url);
+  await ready(page);
+  assert.deepEqual(errors, [], "console errors on load");
+
+  // The scene's own size, so that `umbra trace` (which renders at that size) is comparable.
+  await page.selectOption("#size", "640x480");
+  await ready(page);
+  await page.fill("#line", `${LINE}`);
+  await page.press("#line", "Enter");
+  await ready(page, LINE);
+  const want = trace(LINE, "bouknight-kelley");
+  const aet = await tableRows(page, "aet");
+  assert.deepEqual(aet.map((r) => [r[0], r[1]]), want.active.map(([x, p]) => [x.toFixed(3), `${p}`]), "active edge table");
+  const runs = await page.$$eval("#runs li", (li) => li.map((l) => l.textContent));
+  assert.deepEqual(runs, want.runs.map((r) => `${r.x0}..${r.x1}: polygon ${r.poly}`), "runs");
+  const decisions = await tableRows(page, "decisions");
+  assert.deepEqual(decisions.map((r) => r[4]), want.decisions.map((d) => d.decision.note), "stage decisions");
+
+  // The arrow keys and a click move the scanline.
+  await page.$eval("#line", (i) => i.blur());
+  await page.keyboard.press("ArrowDown");
+  await ready(page, LINE + 1);
+  const box = await page.locator("#overlay").boundingBox();
+  const scale = box.width / 640;
+  await page.mouse.click(box.x + 300.5 * scale, box.y + 200.5 * scale);
+  await ready(page, 200);
+  assert.match(await page.textContent("#pixel"), /^Pixel \(300, 200\)/);
+  const atClick = trace(200, "bouknight-kelley");
+  assert.equal((await tableRows(page, "aet")).length, atClick.active.length, "active edges after a click");
+  if (shots) await page.screenshot({ path: join(shots, "explore-bouknight-kelley.png"), fullPage: true });
+
+  // Switching the stage changes the panels.
+  const before = await page.textContent("#stage-panel");
+  await page.selectOption("#stage", "crow");
+  await page.waitForSelector('#stage-panel[data-stage="crow"]', { timeout: 60000 });
+  await ready(page);
+  const after = await page.textContent("#stage-panel");
+  assert.notEqual(after, before, "the stage panel changed");
+  assert.match(await page.textContent("#stage-title"), /crow/);
+  const crow = trace(200, "crow");
+  assert.deepEqual((await tableRows(page, "decisions")).map((r) => r[4]), crow.decisions.map((d) => d.decision.note));
+  await page.locator("#overlay").click({ position: { x: 330.5 * scale, y: 440.5 * scale } });
+  await ready(page, 440);
+  if (shots) await page.screenshot({ path: join(shots, "explore-crow.png"), fullPage: true });
+
+  // Moving the light renders again.
+  const src = await page.getAttribute("#frame", "src");
+  const summary = await page.textContent("#frame-summary");
+  await page.$eval("#light-x", (i) => { i.value = Number(i.min) + 0.1 * (Number(i.max) - Number(i.min)); i.dispatchEvent(new Event("change")); });
+  await page.waitForFunction((old) => document.getElementById("frame").getAttribute("src") !== old, src, { timeout: 60000 });
+  await ready(page);
+  assert.match(await page.getAttribute("#frame", "src"), /light=/);
+  assert.ok(await page.$eval("#frame", (i) => i.complete && i.naturalWidth > 0), "the new frame loaded");
+  assert.notEqual(await page.textContent("#frame-summary"), summary, "the frame's figures changed");
+
+  // A bad request: a JSON error, shown on the page.
+  const bad = await page.evaluate(async () => {
+    const answers = [];
+    for (const q of ["trace?line=99999", "trace?line=3&shadows=bogus", "frame?width=0", "frame?width=100000", "frame?light=1,nan,2", "frame?colour=red"]) {
+      const r = await fetch(`api/${q}`);
+      answers.push([r.status, (await r.json()).error]);
+    }
+    return answers;
+  });
+  for (const [status, error] of bad) {
+    assert.equal(status, 400);
+    assert.ok(typeof error === "string" && error.length > 10, `a clear error: ${error}`);
+  }
+  await page.$eval("#stage", (s) => { s.appendChild(new Option("bogus", "bogus")); s.value = "bogus"; s.dispatchEvent(new Event("change")); });
+  await page.waitForSelector("#error:not([hidden])", { timeout: 60000 });
+  assert.match(await page.textContent("#error"), /unknown shadow method 'bogus'/);
+
+  // Many requests at once, every one answered.
+  const statuses = await page.evaluate(async () => {
+    const asks = [];
+    for (let i = 0; i < 24; i++) {
+      const stage = ["bouknight-kelley", "crow", "ray-cast", "williams"][i % 4];
+      asks.push(fetch(`api/trace?line=${10 * i}&shadows=${stage}&width=320&height=240`).then((r) => r.status));
+      asks.push(fetch(`api/frame?shadows=${stage}&width=${100 + i}&height=80`).then((r) => r.status));
+    }
+    return Promise.all(asks);
+  });
+  assert.deepEqual(statuses, statuses.map(() => 200), "every concurrent request answered");
+  assert.deepEqual(errors.filter((e) => !/status of 400/.test(e)), [], "console errors other than the bad requests");
+  await page.close();
+}
+
+async function checkExported(browser) {
+  const dir = mkdtempSync(join(tmpdir(), "umbra-explore-"));
+  try {
+    execFileSync(umbra, ["explore", scene, "--export", dir, "--size", "160x120", "--force"], { stdio: "pipe" });
+    const errors = [];
+    const page = await newPage(browser, errors);
+    await page.goto(`file://${dir}/index.html`);
+    await ready(page);
+    await page.fill("#line", "70");
+    await page.press("#line", "Enter");
+    await ready(page, 70);
+    assert.ok((await tableRows(page, "aet")).length > 0, "the exported page shows the active edges");
+    await page.selectOption("#stage", "atherton-weiler-greenberg");
+    await page.waitForSelector('#stage-panel[data-stage="atherton-weiler-greenberg"]', { timeout: 60000 });
+    await ready(page);
+    assert.ok((await tableRows(page, "decisions")).length > 0, "the exported page shows the stage's decisions");
+    if (shots) await page.screenshot({ path: join(shots, "explore-exported-awg.png"), fullPage: true });
+    assert.deepEqual(errors, [], "console errors in the exported page");
+    await page.close();
+  } finally {
+    rmSync(dir, { recursive: true, force: true });
+  }
+}
+
+const [server, url] = await startServer();
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
+  args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+    "--disable-component-update", "--disable-sync"],
+});
+try {
+  await checkLive(browser, url);
+  await checkExported(browser);
+  console.log("explore browser test: ok");
+} finally {
+  await browser.close();
+  server.kill();
+}

@@ -1,0 +1,162 @@
+//! `umbra explore`'s JSON API, answered without a server: the same traces as `trace`, clear
+//! errors for bad requests, many requests at once, and the static export. The page itself is
+//! tested in a real browser by `tests/browser/explore.test.mjs` (run by `.ci/run`).
+
+use serde_json::Value;
+use std::process::Command;
+use umbra::shadow::{ShadowMethod, ShadowOptions};
+use umbra::study::explore::{export, Explorer, Response};
+use umbra::study::trace::trace;
+use umbra::Scene;
+
+fn cornell() -> Scene {
+    Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml")).unwrap()
+}
+
+fn json(r: &Response) -> Value {
+    assert_eq!(r.content_type, "application/json");
+    serde_json::from_slice(&r.body).unwrap()
+}
+
+#[test]
+fn a_traced_line_is_what_trace_gives_at_the_requested_size() {
+    let explorer = Explorer::new(cornell(), "cornell");
+    let mut small = cornell();
+    let mut camera = small.camera().clone();
+    (camera.width, camera.height) = (320, 240);
+    small.set_camera(camera).unwrap();
+    for stage in [ShadowMethod::BouknightKelley, ShadowMethod::Crow, ShadowMethod::AthertonWeilerGreenberg] {
+        for line in [0, 77, 130, 239] {
+            let r = explorer.handle(&format!("/api/trace?line={line}&shadows={}&width=320&height=240", stage.name()));
+            assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
+            let want = serde_json::to_string(&trace(&small, line, stage, &ShadowOptions::default()).unwrap()).unwrap();
+            // Both through the same text, so that both round the same way.
+            let want: Value = serde_json::from_str(&want).unwrap();
+            assert_eq!(json(&r), want, "{} line {line}", stage.name());
+        }
+    }
+}
+
+#[test]
+fn the_frame_marks_no_pixel_for_exact_stages_and_is_an_image() {
+    let explorer = Explorer::new(cornell(), "cornell");
+    let frame = |stage: &str| json(&explorer.handle(&format!("/api/frame?shadows={stage}&width=200&height=150")));
+    for stage in ["bouknight-kelley", "crow", "atherton-weiler-greenberg", "stencil-volume"] {
+        assert_eq!(frame(stage)["differs"]["wrong_total"], 0, "{stage}");
+    }
+    // The shadow map is approximate: its differences are counted, whatever they are.
+    let williams = frame("williams");
+    assert!(williams["stats"]["shadow_counters"]["map_lookups"].as_u64().unwrap() > 0);
+    assert!(williams["differs"]["wrong_total"].as_u64().is_some());
+    let image = explorer.handle("/api/image?shadows=crow&width=200&height=150");
+    assert_eq!((image.status, image.content_type), (200, "image/png"));
+    let png = image::load_from_memory(&image.body).unwrap();
+    assert_eq!((png.width(), png.height()), (200, 150));
+}
+
+#[test]
+fn moving_the_light_moves_the_shadows() {
+    let explorer = Explorer::new(cornell(), "cornell");
+    let at = |q: &str| explorer.handle(&format!("/api/image?shadows=crow&width=160&height=120{q}")).body;
+    let (here, there) = (at(""), at("&light=-2,5,2"));
+    assert_ne!(here, there);
+    let moved = json(&explorer.handle("/api/frame?shadows=crow&width=160&height=120&light=-2%2C5%2C2"));
+    assert_eq!(moved["lights"][0]["at"], serde_json::json!([-2.0, 5.0, 2.0]));
+    assert_eq!(moved["differs"]["wrong_total"], 0);
+}
+
+#[test]
+fn bad_requests_get_a_json_error() {
+    let explorer = Explorer::new(cornell(), "cornell");
+    for (url, says) in [
+        ("/api/trace?line=480", "outside the image"),
+        ("/api/trace?line=-1", "not a line number"),
+        ("/api/trace", "missing parameter 'line'"),
+        ("/api/trace?line=3&shadows=bogus", "unknown shadow method 'bogus'"),
+        ("/api/frame?width=0", "from 1 to 2048"),
+        ("/api/frame?height=99999", "from 1 to 2048"),
+        ("/api/frame?light=1,NaN,2", "three finite numbers"),
+        ("/api/frame?light=1,2", "three finite numbers"),
+        ("/api/frame?colour=red", "unknown parameter 'colour'"),
+    ] {
+        let r = explorer.handle(url);
+        assert_eq!(r.status, 400, "{url}");
+        let error = json(&r)["error"].as_str().unwrap().to_owned();
+        assert!(error.contains(says), "{url}: {error}");
+    }
+    let r = explorer.handle("/etc/passwd");
+    assert_eq!(r.status, 404);
+    assert!(json(&r)["error"].as_str().unwrap().contains("no such page"));
+}
+
+#[test]
+fn many_requests_at_once_are_all_answered_alike() {
+    let explorer = Explorer::new(cornell(), "cornell");
+    let urls: Vec<String> = (0..16)
+        .map(|i| {
+            let stage = ["crow", "bouknight-kelley", "ray-cast", "williams"][i % 4];
+            format!("/api/trace?line={}&shadows={stage}&width=160&height=120", 7 * i)
+        })
+        .collect();
+    let alone: Vec<Response> = urls.iter().map(|u| explorer.handle(u)).collect();
+    let together: Vec<Response> = std::thread::scope(|s| {
+        let asks: Vec<_> = urls.iter().map(|u| s.spawn(|| explorer.handle(u))).collect();
+        asks.into_iter().map(|a| a.join().unwrap()).collect()
+    });
+    assert!(alone.iter().all(|r| r.status == 200));
+    assert_eq!(alone, together);
+}
+
+#[test]
+fn the_export_holds_every_line_of_every_applicable_stage() {
+    let dir = std::env::temp_dir().join(format!("umbra-explore-export-{}", std::process::id()));
+    let explorer = Explorer::new(cornell(), "cornell");
+    export(&explorer, &dir, 64, 48, &ShadowMethod::ALL).unwrap();
+    for name in ["index.html", "explore.js", "explore.css", "data.js"] {
+        assert!(dir.join(name).is_file(), "{name}");
+    }
+    let page = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    assert!(page.contains(r#"<script src="data.js"></script>"#));
+    let watkins = std::fs::read_to_string(dir.join("lines/watkins.js")).unwrap();
+    assert_eq!(watkins.lines().count(), 48);
+    assert!(watkins.lines().all(|l| l.starts_with("umbraLine({") && l.ends_with("});")));
+    let watkins = std::fs::read_to_string(dir.join("lines/watkins.js")).unwrap();
+    assert_eq!(watkins.lines().count(), 48);
+    assert!(watkins.lines().all(|l| l.starts_with("umbraLine({") && l.ends_with("});")));
+    for stage in ["bouknight-kelley", "crow", "atherton-weiler-greenberg", "ray-cast", "williams"] {
+        let lines = std::fs::read_to_string(dir.join(format!("lines/{stage}.js"))).unwrap();
+        assert_eq!(lines.lines().count(), 48, "{stage}");
+        assert!(lines.lines().all(|l| l.starts_with(&format!("umbraDecisions(\"{stage}\", ")) && l.ends_with("]);")));
+        assert!(dir.join(format!("frames/{stage}.png")).is_file());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_command_stops_on_a_bad_scene_before_serving() {
+    let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
+        .args(["explore", "no-such-scene.toml", "--port", "0"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("no-such-scene.toml") && !err.contains("http://"), "{err}");
+
+    let dir = std::env::temp_dir().join(format!("umbra-explore-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("keep.txt"), "mine").unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml");
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_umbra")).args(["explore", scene, "--export"]).arg(&dir).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("pass --force"));
+    let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
+        .args(["explore", scene, "--size", "9999x10", "--export"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("WIDTHxHEIGHT"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
