@@ -83,10 +83,10 @@ async function checkLive(browser, url) {
   await ready(page, LINE + 1);
   const box = await page.locator("#overlay").boundingBox();
   const scale = box.width / 640;
-  await page.mouse.click(box.x + 300.5 * scale, box.y + 200.5 * scale);
-  await ready(page, 200);
-  assert.match(await page.textContent("#pixel"), /^Pixel \(300, 200\)/);
-  const atClick = trace(200, "bouknight-kelley");
+  await page.mouse.click(box.x + 210.5 * scale, box.y + 440.5 * scale);
+  await ready(page, 440);
+  assert.match(await page.textContent("#pixel"), /^Pixel \(210, 440\)/);
+  const atClick = trace(440, "bouknight-kelley");
   assert.equal((await tableRows(page, "aet")).length, atClick.active.length, "active edges after a click");
   if (shots) await page.screenshot({ path: join(shots, "explore-bouknight-kelley.png"), fullPage: true });
 
@@ -98,10 +98,12 @@ async function checkLive(browser, url) {
   const after = await page.textContent("#stage-panel");
   assert.notEqual(after, before, "the stage panel changed");
   assert.match(await page.textContent("#stage-title"), /crow/);
-  const crow = trace(200, "crow");
+  const crow = trace(440, "crow");
   assert.deepEqual((await tableRows(page, "decisions")).map((r) => r[4]), crow.decisions.map((d) => d.decision.note));
-  await page.locator("#overlay").click({ position: { x: 330.5 * scale, y: 440.5 * scale } });
-  await ready(page, 440);
+  await page.locator("#overlay").click({ position: { x: 305.5 * scale, y: 300.5 * scale } });
+  await ready(page, 300);
+  await page.locator("#overlay").click({ position: { x: 305.5 * scale, y: 440.5 * scale } });
+  await page.waitForFunction(() => /^Pixel \(305, 440\)/.test(document.getElementById("pixel").textContent));
   if (shots) await page.screenshot({ path: join(shots, "explore-crow.png"), fullPage: true });
 
   // Moving the light renders again.
