@@ -96,9 +96,32 @@ struct ShadowArgs {
     /// Williams: fit each map to the whole scene, not to the points the camera sees.
     #[arg(long)]
     no_fit: bool,
+    /// Planar: project shadows onto this object too (its name, or its index in the file;
+    /// repeat for several), or `auto`: every flat object at least a tenth the area of the
+    /// largest (the ground, the walls). Objects marked `receiver = true` in the file stay.
+    #[arg(long, value_name = "NAME|auto")]
+    receiver: Vec<String>,
 }
 
 impl ShadowArgs {
+    /// Loads the scene and marks the receivers asked for with `--receiver`.
+    fn load(&self, path: &std::path::Path) -> umbra::Result<Scene> {
+        let mut scene = Scene::load(path)?;
+        for name in &self.receiver {
+            if name == "auto" {
+                if scene.mark_planar_receivers().is_empty() {
+                    return Err(Error::Invalid(format!("{}: --receiver auto found no flat object", path.display())));
+                }
+                continue;
+            }
+            let object = scene.object_named(name).or_else(|| name.parse().ok()).ok_or_else(|| {
+                Error::Invalid(format!("{}: --receiver {name}: no object of that name", path.display()))
+            })?;
+            scene.set_receiver(object, true).map_err(|e| Error::Invalid(format!("--receiver {name}: {e}")))?;
+        }
+        Ok(scene)
+    }
+
     fn options(&self, keep_outlines: bool) -> umbra::Result<ShadowOptions> {
         let filter = match self.shadow_filter {
             FilterArg::Nearest => ShadowFilter::Nearest,
@@ -438,7 +461,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
                     a.shadows
                 )));
             }
-            let scene = Scene::load(&a.scene)?;
+            let scene = a.shadow.load(&a.scene)?;
             let opts = RenderOptions {
                 visibility: a.visibility,
                 shadows: a.shadows,
@@ -463,7 +486,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
             Ok(())
         }
         Command::Compare(a) => {
-            let scene = Scene::load(&a.scene)?;
+            let scene = a.shadow.load(&a.scene)?;
             let d = CompareOptions::default();
             let opts = CompareOptions {
                 visibility: if a.visibility.is_empty() { d.visibility } else { a.visibility },
@@ -484,7 +507,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
             Ok(())
         }
         Command::Bench(a) => {
-            let scene = Scene::load(&a.scene)?;
+            let scene = a.shadow.load(&a.scene)?;
             let opts = umbra::study::bench::BenchOptions {
                 visibility: a.visibility,
                 shadows: a.shadows,
@@ -515,6 +538,12 @@ fn run(cli: Cli) -> umbra::Result<()> {
             }
         }
         Command::Scale(a) => {
+            if !a.shadow.receiver.is_empty() {
+                return Err(Error::Invalid(
+                    "--receiver marks objects of a scene file, and scale generates its scenes: it cannot be used here"
+                        .into(),
+                ));
+            }
             let methods = if a.methods.is_empty() {
                 vec![(VisibilityMethod::Scanline, ShadowMethod::None), (VisibilityMethod::ZBuffer, ShadowMethod::None)]
             } else {
@@ -543,7 +572,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
             Ok(())
         }
         Command::Trace(a) => {
-            let scene = Scene::load(&a.scene)?;
+            let scene = a.shadow.load(&a.scene)?;
             let t = umbra::study::trace::trace(&scene, a.line, a.shadows, &a.shadow.options(false)?)?;
             if let Some(x) = a.x.filter(|&x| x >= scene.camera().width) {
                 return Err(Error::Invalid(format!("--x {x} is outside the image (width {})", scene.camera().width)));

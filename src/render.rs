@@ -171,65 +171,64 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     let mut bar = crate::progress::Bar::new(opts.progress, h as u64, "{msg} {bar:40} {pos}/{len} lines {elapsed}");
     bar.set_message("rendering");
     let progress = Mutex::new(bar);
-    let counters: Vec<Counters> = jobs
+    let sample_count: usize = ctx.samples.iter().map(Vec::len).sum();
+    let bands: Vec<(Counters, Duration, Duration)> = jobs
         .into_par_iter()
         .map(|out| {
             let Band { y0, color, id, mut light, mut tests } = out;
             let y1 = y0 + (id.len() / w as usize) as u32;
             let mut shadow = Counters::default();
             let mut walker = shadows.walker();
-            let mut lit = vec![0.0f32; w as usize];
+            // Each sample's lit fraction along the line, sample by sample.
+            let mut lit = vec![0.0f32; sample_count * w as usize];
             let mut rs = RunShading::default();
-            let mut self_shadowed = 0u64;
+            let (mut self_shadowed, mut walking, mut shading) = (0u64, Duration::ZERO, Duration::ZERO);
             for (y, runs) in (y0..y1).zip(&runs.lines[y0 as usize..y1 as usize]) {
-                walker.start_line(y);
                 let row = ((y - y0) * w) as usize;
+                let t = Instant::now();
+                walker.start_line(y);
+                let tests = tests.as_deref_mut().map(|t| &mut t[row..row + w as usize]);
+                self_shadowed += walk_line(&ctx, walker.as_mut(), y, runs, &mut lit, tests);
+                let t2 = Instant::now();
+                walking += t2 - t;
                 for run in runs {
                     let (a, b) = (row + run.x0 as usize, row + run.x1 as usize);
-                    let poly = &scene.polygons[run.poly as usize];
-                    id[a..b].fill(poly.face);
+                    id[a..b].fill(scene.polygons[run.poly as usize].face);
                     color[a..b].fill(shader.ambient(run.poly as usize));
                     shader.begin_run(run, y, &mut rs);
-                    for (l, samples) in ctx.samples.iter().enumerate() {
-                        let share = 1.0 / samples.len() as f32;
-                        for (s, sample) in samples.iter().enumerate() {
-                            let lit = &mut lit[..(run.x1 - run.x0) as usize];
-                            if sample.on_seen_side(&poly.plane, view.eye) {
-                                walker.lit(l, s, y, run, lit);
-                                if let Some(tests) = tests.as_deref_mut() {
-                                    for (x0, x1, n) in walker.decision().tested {
-                                        for t in &mut tests[row + x0 as usize..row + x1 as usize] {
-                                            *t += n;
-                                        }
-                                    }
-                                }
-                            } else {
-                                lit.fill(0.0);
-                                self_shadowed += 1;
-                            }
-                            for (f, &v) in light[l][a..b].iter_mut().zip(lit.iter()) {
-                                *f += v * share;
-                            }
-                            shader.add_light(&mut rs, l, s, lit, &mut color[a..b]);
+                    for (k, (l, s, _)) in ctx.all_samples().enumerate() {
+                        let at = k * w as usize;
+                        let lit = &lit[at + run.x0 as usize..at + run.x1 as usize];
+                        let share = 1.0 / ctx.samples[l].len() as f32;
+                        for (f, &v) in light[l][a..b].iter_mut().zip(lit) {
+                            *f += v * share;
                         }
+                        shader.add_light(&mut rs, l, s, lit, &mut color[a..b]);
                     }
                 }
+                shading += t2.elapsed();
             }
             walker.finish(&mut shadow);
             shadow.add("self_shadowed_runs", self_shadowed);
             if let Ok(mut p) = progress.lock() {
                 p.advance((y1 - y0) as u64);
             }
-            shadow
+            (shadow, walking, shading)
         })
         .collect();
     if let Ok(p) = progress.lock() {
         p.finish();
     }
-    for shadow in &counters {
+    // The bands ran on several threads: the wall-clock time of the pass is split between
+    // the shadow walk and the shading in the proportion of their summed band times.
+    let pass = ms(t.elapsed());
+    let (walking, shading) = bands.iter().fold((0.0, 0.0), |(a, b), band| (a + ms(band.1), b + ms(band.2)));
+    let walk_share = if walking + shading > 0.0 { walking / (walking + shading) } else { 0.0 };
+    for (shadow, ..) in &bands {
         stats.shadow_counters.merge(shadow);
     }
-    stats.time_ms.insert("shading", ms(t.elapsed()));
+    stats.time_ms.insert("shadow_walk", pass * walk_share);
+    stats.time_ms.insert("shading", pass * (1.0 - walk_share));
     stats.time_ms.insert("total", ms(start.elapsed()));
     frame.counters = pixel_counters;
     let outlines = shadows.outlines();
@@ -240,6 +239,43 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     }
     saturate(&mut frame.color);
     Ok(Rendered { frame, stats, outlines })
+}
+
+/// The shadow stage's walk along line `y`: for every run and light sample, the lit fraction
+/// of each pixel into `lit[k * width + x]` (`k` the sample's flat index), 0 where the
+/// sample is behind the run's seen side (the same-side rule, asked before the stage); the
+/// stage's tests per pixel added into `tests` when asked. Returns the runs the same-side
+/// rule settled.
+fn walk_line(
+    ctx: &ShadowContext,
+    walker: &mut dyn crate::shadow::ShadowWalker,
+    y: u32,
+    runs: &[crate::visibility::Run],
+    lit: &mut [f32],
+    mut tests: Option<&mut [u32]>,
+) -> u64 {
+    let width = ctx.view.width as usize;
+    let mut self_shadowed = 0;
+    for run in runs {
+        let plane = &ctx.scene.polygons[run.poly as usize].plane;
+        for (k, (l, s, sample)) in ctx.all_samples().enumerate() {
+            let out = &mut lit[k * width + run.x0 as usize..k * width + run.x1 as usize];
+            if !sample.on_seen_side(plane, ctx.view.eye) {
+                out.fill(0.0);
+                self_shadowed += 1;
+                continue;
+            }
+            walker.lit(l, s, y, run, out);
+            if let Some(tests) = tests.as_deref_mut() {
+                for (x0, x1, n) in walker.decision().tested {
+                    for t in &mut tests[x0 as usize..x1 as usize] {
+                        *t += n;
+                    }
+                }
+            }
+        }
+    }
+    self_shadowed
 }
 
 /// Every input is finite in single precision, but products of large ones can overflow: a

@@ -59,6 +59,10 @@ pub struct Stats {
     pub shadow_counters: Counters,
     /// Milliseconds per step (wall clock): `view` (clipping and projection), `visibility`
     /// (preparing the stage and resolving every line into runs), `shadow_prepare`,
-    /// `shading` (the shadow stage's walk and the shading of every run), `total`.
+    /// `shadow_walk` (the shadow stage's per-line walk: which pixels of each run every light
+    /// sample reaches), `shading` (the shading of every run), `total`; `reflections` when a
+    /// mirror is seen. The walk and the shading run line by line in the same parallel pass;
+    /// that pass's wall-clock time is split between them in the proportion of their summed
+    /// per-band times.
     pub time_ms: BTreeMap<&'static str, f64>,
 }

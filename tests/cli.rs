@@ -213,7 +213,7 @@ fn bench_reports_spread_phases_and_memory() {
         let (min, median, max) =
             (r["min_ms"].as_f64().unwrap(), r["median_ms"].as_f64().unwrap(), r["max_ms"].as_f64().unwrap());
         assert!(0.0 < min && min <= median && median <= max, "{r}");
-        for phase in ["view", "visibility", "shadow_prepare", "shading"] {
+        for phase in ["view", "visibility", "shadow_prepare", "shadow_walk", "shading"] {
             assert!(r["phases"][phase]["median_ms"].as_f64().is_some(), "{phase} missing in {r}");
         }
         assert!(r["peak_rss_mb"].as_f64().unwrap() > 1.0, "{r}");
@@ -257,4 +257,30 @@ fn nothing_silent() {
     for (v, p) in view.pixels().zip(packed.pixels()) {
         assert_eq!(p.0 == [255; 4], v.0 == [0, 0, 0]);
     }
+}
+
+#[test]
+fn receiver_makes_planar_shadows_usable_on_any_scene() {
+    let cornell = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml");
+    let d = tmp("receiver");
+    let out = d.join("planar.png");
+    let out = out.to_str().unwrap();
+    refused(&["render", cornell, "--shadows", "planar", "-o", out], "receiver");
+    let stats = |args: &[&str]| -> serde_json::Value {
+        let o =
+            umbra().args(["render", cornell, "--shadows", "planar", "--stats", "-o", out]).args(args).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    // By name, by index, and the flat objects chosen automatically (the two side walls:
+    // the floor, ceiling and back wall are one object, which is not flat).
+    assert_eq!(stats(&["--receiver", "left wall"])["shadow_counters"]["receivers"], 1);
+    assert_eq!(stats(&["--receiver", "2"])["shadow_counters"]["receivers"], 1);
+    assert_eq!(stats(&["--receiver", "auto"])["shadow_counters"]["receivers"], 2);
+    refused(
+        &["render", cornell, "--shadows", "planar", "--receiver", "the moon", "-o", out],
+        "--receiver the moon: no object",
+    );
+    refused(&["render", cornell, "--shadows", "planar", "--receiver", "9", "-o", out], "no object 9");
+    refused(&["scale", "--sweep", "cubes", "--values", "1", "--receiver", "auto"], "cannot be used here");
 }

@@ -658,6 +658,42 @@ impl Scene {
         Ok(())
     }
 
+    /// The index of the object called `name`.
+    pub fn object_named(&self, name: &str) -> Option<usize> {
+        self.objects.iter().position(|o| o.name.as_deref() == Some(name))
+    }
+
+    /// Marks the large planar objects as receivers of Blinn's planar shadows, and returns
+    /// them: every object whose polygons all lie in one plane (normals within 10⁻⁶, offsets
+    /// within 10⁻⁶ of the scene's size) and whose area is at least a tenth of the largest
+    /// such object's. On a typical scene that is the ground and the walls; an object that
+    /// is not flat (a cube, a sphere) is never one.
+    pub fn mark_planar_receivers(&mut self) -> Vec<usize> {
+        let size = self.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(f64::MIN_POSITIVE));
+        let mut area = vec![Some(0.0f64); self.objects.len()];
+        let mut plane: Vec<Option<crate::geometry::Plane>> = vec![None; self.objects.len()];
+        for (i, p) in self.polygons.iter().enumerate() {
+            let o = p.object as usize;
+            let same = |q: &crate::geometry::Plane| {
+                (q.n - p.plane.n).length() <= 1e-6 && (q.d - p.plane.d).abs() <= 1e-6 * size
+            };
+            match plane[o] {
+                Some(q) if !same(&q) => area[o] = None,
+                _ => plane[o] = Some(p.plane),
+            }
+            if let Some(a) = &mut area[o] {
+                *a += 0.5 * crate::geometry::newell_normal(self.verts(i)).length();
+            }
+        }
+        let largest = area.iter().flatten().fold(0.0f64, |m, &a| m.max(a));
+        let chosen: Vec<usize> =
+            (0..self.objects.len()).filter(|&o| area[o].is_some_and(|a| a > 0.0 && a >= 0.1 * largest)).collect();
+        for &o in &chosen {
+            self.objects[o].receiver = true;
+        }
+        chosen
+    }
+
     /// The compiled world-space polygons: degenerate faces left out, non-planar faces split
     /// into fans.
     pub fn polygons(&self) -> &[Polygon] {
@@ -704,5 +740,22 @@ impl Scene {
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
         let first = *self.vertices.first()?;
         Some(self.vertices.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_flat_ground_is_the_planar_receiver_and_no_cube_is() {
+        let mut scene = crate::generate::cubes(3, false, 64, 48).unwrap();
+        assert!(scene.objects().iter().all(|o| !o.receiver));
+        let chosen = scene.mark_planar_receivers();
+        assert_eq!(chosen.len(), 1);
+        let ground = chosen[0];
+        assert!(scene.objects()[ground].receiver);
+        // The ground is flat: every polygon of it in one plane; no other object is.
+        let planes: Vec<_> = scene.polygons().iter().filter(|p| p.object as usize == ground).map(|p| p.plane).collect();
+        assert!(planes.windows(2).all(|w| (w[0].n - w[1].n).length() < 1e-9));
+        assert_eq!(scene.objects().iter().filter(|o| o.receiver).count(), 1);
     }
 }

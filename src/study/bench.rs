@@ -122,8 +122,11 @@ fn peak_rss_mb() -> f64 {
 /// The rows as a readable table: one line per method, the frame and each phase as
 /// `median (min–max)`.
 pub fn table(rows: &[BenchRow]) -> String {
-    let phases: std::collections::BTreeSet<&str> =
-        rows.iter().flat_map(|r| r.phases.keys().map(String::as_str)).collect();
+    // The phases in the pipeline's order, then any others by name.
+    const ORDER: [&str; 6] = ["view", "visibility", "shadow_prepare", "shadow_walk", "shading", "reflections"];
+    let mut phases: Vec<&str> = rows.iter().flat_map(|r| r.phases.keys().map(String::as_str)).collect();
+    phases.sort_by_key(|p| (ORDER.iter().position(|o| o == p).unwrap_or(ORDER.len()), *p));
+    phases.dedup();
     let cell = |s: &Spread| format!("{:.1} ({:.1}–{:.1})", s.median_ms, s.min_ms, s.max_ms);
     let mut out = format!("{:<10} {:<26} {:>24}", "visibility", "shadows", "frame ms: median (min–max)");
     for p in &phases {

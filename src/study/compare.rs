@@ -295,6 +295,7 @@ fn html(report: &Report) -> String {
         "time (ms)",
         "visibility (ms)",
         "shadow prepare (ms)",
+        "shadow walk (ms)",
         "shading (ms)",
         "wrong / interior",
         "error",
@@ -307,7 +308,7 @@ fn html(report: &Report) -> String {
         let class = if r.status == "ok" { "" } else { " class=\"na\"" };
         let _ = writeln!(
             h,
-            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td></tr>",
+            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td></tr>",
             r.visibility,
             r.shadows,
             escape(&r.status),
@@ -315,6 +316,7 @@ fn html(report: &Report) -> String {
             r.time_ms,
             step("visibility"),
             step("shadow_prepare"),
+            step("shadow_walk"),
             step("shading"),
             r.wrong_pixels,
             r.interior_pixels,
