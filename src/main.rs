@@ -573,7 +573,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
         }
         Command::Trace(a) => {
             let scene = a.shadow.load(&a.scene)?;
-            let t = umbra::study::trace::trace(&scene, a.line, a.shadows, &a.shadow.options(false)?)?;
+            let t = umbra::study::trace::trace(&scene, a.line, a.shadows, &a.shadow.options(true)?)?;
             if let Some(x) = a.x.filter(|&x| x >= scene.camera().width) {
                 return Err(Error::Invalid(format!("--x {x} is outside the image (width {})", scene.camera().width)));
             }

@@ -40,6 +40,7 @@ use crate::stats::Counters;
 use crate::visibility::Run;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -48,13 +49,27 @@ pub struct BouknightKelley<'a> {
     ctx: &'a ShadowContext<'a>,
     /// `shadows[sample_index(l, s)]`.
     shadows: Vec<Overlay>,
+    /// What became of each receiver's pairs, per sample, when the options keep outlines
+    /// (for traces).
+    pairs: Vec<FxHashMap<u32, Pairs>>,
+}
+
+/// What became of one receiver's pairs (kept for traces).
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct Pairs {
+    /// The casters the prefilter kept (all casters without it).
+    pub kept: Vec<u32>,
+    /// Of those, the ones wholly behind the receiver as the light sees it.
+    pub behind: Vec<u32>,
+    /// The caster of each shadow polygon on the receiver: `(shadow polygon, caster)`.
+    pub shadow_polygons: Vec<(u32, u32)>,
 }
 
 impl<'a> BouknightKelley<'a> {
     /// Makes the shadow polygons of every light sample.
     pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
-        let shadows = ctx.all_samples().map(|(_, _, sample)| shadow_polygons(ctx, sample, counters)).collect();
-        BouknightKelley { ctx, shadows }
+        let (shadows, pairs) = ctx.all_samples().map(|(_, _, sample)| shadow_polygons(ctx, sample, counters)).unzip();
+        BouknightKelley { ctx, shadows, pairs }
     }
 }
 
@@ -62,7 +77,11 @@ impl<'a> BouknightKelley<'a> {
 /// light on their seen side; each gathers its candidate casters (through the prefilter, or
 /// all of them), drops those wholly behind it, and projects the rest. Receivers are
 /// independent, so they are worked on in parallel.
-fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Counters) -> Overlay {
+fn shadow_polygons(
+    ctx: &ShadowContext,
+    sample: LightSample,
+    counters: &mut Counters,
+) -> (Overlay, FxHashMap<u32, Pairs>) {
     let scene = ctx.scene;
     let n = scene.polygons.len();
     counters.add("pairs", (n as u64) * (n as u64).saturating_sub(1));
@@ -80,7 +99,8 @@ fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Coun
     let grid = ctx.options.prefilter.then(|| SphereGrid::new(scene, sample, &casters));
     counters.add("prefilter_grid_us", t.elapsed().as_micros() as u64);
 
-    let per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>)> = receivers
+    let record = ctx.options.keep_outlines;
+    let per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>, Pairs)> = receivers
         .par_iter()
         .map_init(
             || (Projector::default(), vec![u32::MAX; n], [Vec::new(), Vec::new()], Vec::new()),
@@ -94,6 +114,7 @@ fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Coun
                 tally.prefilter_ns += t.elapsed().as_nanos() as u64;
                 let t = Instant::now();
                 let mut rings = Vec::new();
+                let mut pairs = Pairs::default();
                 let plane = scene.polygons[b as usize].plane;
                 let side = light_side(&plane, sample);
                 let rect = bounding_rectangle(scene.verts(b as usize), &plane);
@@ -102,26 +123,42 @@ fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Coun
                         continue;
                     }
                     tally.kept += 1;
+                    if record {
+                        pairs.kept.push(a);
+                    }
                     if scene.verts(a as usize).iter().all(|&v| plane.distance(v) * side <= 0.0) {
                         tally.behind += 1;
+                        if record {
+                            pairs.behind.push(a);
+                        }
                     } else if !proj.project(scene.verts(a as usize), &plane, &rect, sample) {
                         tally.empty += 1;
                     } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
                         rings.push(ring.clone());
+                        if record {
+                            pairs.shadow_polygons.push((0, a));
+                        }
                     }
                 }
                 tally.projection_ns += t.elapsed().as_nanos() as u64;
-                (b, tally, rings)
+                (b, tally, rings, pairs)
             },
         )
         .collect();
 
     let mut overlay = Overlay::new(ctx.view.height, ctx.options.keep_outlines);
     let mut total = Tally::default();
-    for (b, tally, rings) in &per_receiver {
-        total.add(tally);
-        for r in rings {
-            overlay.add(*b, r);
+    let mut kept_pairs = FxHashMap::default();
+    for (b, tally, rings, mut pairs) in per_receiver {
+        total.add(&tally);
+        for (i, r) in rings.iter().enumerate() {
+            let tag = overlay.add(b, r);
+            if let Some(p) = pairs.shadow_polygons.get_mut(i) {
+                p.0 = tag;
+            }
+        }
+        if record {
+            kept_pairs.insert(b, pairs);
         }
     }
     overlay.finish();
@@ -133,7 +170,7 @@ fn shadow_polygons(ctx: &ShadowContext, sample: LightSample, counters: &mut Coun
     counters.add("shadow_polygons", overlay.len() as u64);
     counters.add("prefilter_cpu_us", total.prefilter_ns / 1000);
     counters.add("projection_cpu_us", total.projection_ns / 1000);
-    overlay
+    (overlay, kept_pairs)
 }
 
 /// What happened to one receiver's pairs.
@@ -307,7 +344,7 @@ impl ShadowStage for BouknightKelley<'_> {
             segments: 0,
             splits: 0,
             depth_max: 0,
-            last: (0, 0, 0, 0),
+            last: (0, 0, 0, 0, 0, 0),
         })
     }
 }
@@ -319,8 +356,8 @@ struct Walker<'s> {
     segments: u64,
     splits: u64,
     depth_max: u32,
-    /// The last run, and its segments and splits.
-    last: (u32, u32, u64, u64),
+    /// The last run, its segments and splits, its sample and its polygon.
+    last: (u32, u32, u64, u64, usize, u32),
 }
 
 /// Step 4 on segment `a..b`, given the shadow polygons' intervals that may touch it: calls
@@ -370,7 +407,7 @@ impl ShadowWalker for Walker<'_> {
         self.segments += segments;
         self.splits += splits;
         self.depth_max = self.depth_max.max(depth_max);
-        self.last = (run.x0, run.x1, segments, splits);
+        self.last = (run.x0, run.x1, segments, splits, k, run.poly);
     }
 
     fn decision(&self) -> Decision {
@@ -390,7 +427,11 @@ impl ShadowWalker for Walker<'_> {
                 self.last.2,
                 self.last.3
             ),
-            detail: Detail::Segments { covers, segments },
+            detail: Detail::Segments {
+                covers,
+                segments,
+                pairs: self.stage.pairs.get(self.last.4).and_then(|p| p.get(&self.last.5)).cloned(),
+            },
         }
     }
 

@@ -49,7 +49,8 @@ pub struct ShadowOptions {
     /// render many views of one database; `None` builds it.
     pub awg_database: Option<std::sync::Arc<Vec<ShadowDatabase>>>,
     /// Keep the screen outlines of the stage's polygons (shadow polygons, detail polygons)
-    /// for drawing them over the image.
+    /// for drawing them over the image, and what traces show of them (Bouknight-Kelley:
+    /// what became of each receiver's pairs).
     pub keep_outlines: bool,
 }
 
@@ -165,12 +166,24 @@ pub enum Detail {
         covers: Vec<Cover>,
         /// Every segment examined.
         segments: Vec<Segment>,
+        /// What became of the run's polygon's pairs (steps 1-3), when the stage kept them.
+        pairs: Option<bouknight_kelley::Pairs>,
     },
     /// Atherton-Weiler-Greenberg: the lit detail polygons on the run's polygon that cover
     /// pixels of the run.
     Covers {
         /// Detail polygons over the run.
         covers: Vec<Cover>,
+    },
+    /// Williams: where each pixel of the run falls in its shadow map, the nearness the map
+    /// holds there and the point's threshold.
+    Texels {
+        /// Texels along each side of the map.
+        size: u32,
+        /// The side of the filter's kernel in texels (1: nearest).
+        kernel: u32,
+        /// Each pixel's lookup.
+        texels: Vec<Texel>,
     },
     /// Crow: what each shadow polygon over the run adds to the count, and the count.
     Counts {
@@ -190,6 +203,22 @@ pub struct Cover {
     pub start: u32,
     /// One past the last.
     pub end: u32,
+}
+
+/// Where one pixel's point falls in a shadow map (Williams).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Texel {
+    /// The pixel.
+    pub x: u32,
+    /// Its texel coordinates in the map (a cube map: in the face it falls in).
+    pub u: f32,
+    /// Its texel coordinates in the map.
+    pub v: f32,
+    /// The nearness the map holds at that texel (`1/z` from the light, or minus the depth
+    /// for a directional light's map); `None` outside the map or where nothing was drawn.
+    pub map: Option<f32>,
+    /// The point's own nearness with the bias: a texel hides the point when it holds more.
+    pub threshold: f32,
 }
 
 /// One scan segment Bouknight-Kelley examined.

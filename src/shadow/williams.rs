@@ -24,7 +24,7 @@
 //! every pixel written to a screen-sized buffer, blurred by the seed's separable 15-tap
 //! Gaussian, and used when shading).
 
-use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, ShadowContext, ShadowStage, ShadowWalker, Texel};
 use crate::error::{Error, Result};
 use crate::geometry::Plane;
 use crate::scene::{Camera, LightSample};
@@ -341,6 +341,19 @@ impl DepthMap {
     /// batches: first every point of a batch is located in the map, four at a time in vector
     /// registers, then every kernel is compared.
     fn lit_run(&self, h0: DVec4, step: DVec4, bias: &Bias, r: usize, batch: &mut Located, out: &mut [f32]) {
+        let lookup = self.lookup(h0, step, bias, r);
+        for (b, out) in out.chunks_mut(BATCH).enumerate() {
+            self.locate(&lookup, b * BATCH, out.len(), r, batch);
+            match lookup.receiver_plane {
+                Some(gradient) => self.filter_receiver_plane(batch, r, gradient, out),
+                None => self.filter(batch, r, out),
+            }
+        }
+    }
+
+    /// What every point of a run shares: its start and step in light space, in single
+    /// precision, and the bias terms.
+    fn lookup(&self, h0: DVec4, step: DVec4, bias: &Bias, r: usize) -> Lookup {
         let [rx, ry, rz] = self.rows;
         let (h0, step) = (self.offset_point(h0, bias), self.offset_point(step, bias));
         // In single precision from here: its rounding (a few parts in 10⁷ of the depth) is
@@ -359,38 +372,52 @@ impl DepthMap {
             Projection::Perspective(view) => (b0, (bias.texels * 2.0 * view.t / view.height as f64) as f32),
             Projection::Ortho { texel, .. } => (b0 + (bias.texels * texel) as f32, 0.0),
         };
-        for (b, out) in out.chunks_mut(BATCH).enumerate() {
-            let groups = out.len().div_ceil(4);
-            for g in 0..groups {
-                let t = f32x4::splat((b * BATCH + 4 * g) as f32) + f32x4::new([0.0, 1.0, 2.0, 3.0]);
-                // The four points in light space.
-                let [x, y, z, w] = [0, 1, 2, 3].map(|c| f32x4::splat(l0[c]) + f32x4::splat(dl[c]) * t);
-                let (px, py, threshold) = match self.proj {
-                    // `Z_map + b0 + b1·z < z` means shadow, that is `1/Z_map > 1/(z(1 − b1)
-                    // − b0)` with `z = Z/w`; the slope term is added in nearness: the
-                    // threshold is `w / (Z(1 − b1) − b0·w) + bs`. A point behind the light, or within the bias of
-                    // it, is lit: it goes far outside the map.
-                    Projection::Perspective(_) => {
-                        let denom = z * (1.0 - b1) - w * b0;
-                        let ahead = z.simd_gt(0.0) & denom.simd_gt(0.0);
-                        let q = f32x4::ONE / z;
-                        let far = f32x4::splat(f32::NEG_INFINITY);
-                        let threshold = w / denom + f32x4::splat(bs);
-                        (ahead.select(x * q, far), ahead.select(y * q, far), ahead.select(threshold, -far))
-                    }
-                    // The map holds `−Z_map`: shadow when `−Z_map > b0 − z + bs`.
-                    Projection::Ortho { .. } => {
-                        let q = f32x4::ONE / w;
-                        (x * q, y * q, f32x4::splat(b0 + bs) - z * q)
-                    }
-                };
-                batch.put(g, px, py, threshold, r, self.size);
-            }
-            match receiver_plane {
-                Some(gradient) => self.filter_receiver_plane(batch, r, gradient, out),
-                None => self.filter(batch, r, out),
-            }
+        Lookup { l0, dl, b0, b1, bs, receiver_plane }
+    }
+
+    /// Locates points `from..from + len` of a run (at most [`BATCH`]) in the map, four at a
+    /// time in vector registers: their texel coordinates and the nearness above which a
+    /// texel hides them.
+    #[inline]
+    fn locate(&self, lk: &Lookup, from: usize, len: usize, r: usize, batch: &mut Located) {
+        let Lookup { l0, dl, b0, b1, bs, .. } = *lk;
+        for g in 0..len.div_ceil(4) {
+            let t = f32x4::splat((from + 4 * g) as f32) + f32x4::new([0.0, 1.0, 2.0, 3.0]);
+            // The four points in light space.
+            let [x, y, z, w] = [0, 1, 2, 3].map(|c| f32x4::splat(l0[c]) + f32x4::splat(dl[c]) * t);
+            let (px, py, threshold) = match self.proj {
+                // `Z_map + b0 + b1·z < z` means shadow, that is `1/Z_map > 1/(z(1 − b1)
+                // − b0)` with `z = Z/w`; the slope term is added in nearness: the
+                // threshold is `w / (Z(1 − b1) − b0·w) + bs`. A point behind the light, or within the bias of
+                // it, is lit: it goes far outside the map.
+                Projection::Perspective(_) => {
+                    let denom = z * (1.0 - b1) - w * b0;
+                    let ahead = z.simd_gt(0.0) & denom.simd_gt(0.0);
+                    let q = f32x4::ONE / z;
+                    let far = f32x4::splat(f32::NEG_INFINITY);
+                    let threshold = w / denom + f32x4::splat(bs);
+                    (ahead.select(x * q, far), ahead.select(y * q, far), ahead.select(threshold, -far))
+                }
+                // The map holds `−Z_map`: shadow when `−Z_map > b0 − z + bs`.
+                Projection::Ortho { .. } => {
+                    let q = f32x4::ONE / w;
+                    (x * q, y * q, f32x4::splat(b0 + bs) - z * q)
+                }
+            };
+            batch.put(g, px, py, threshold, r, self.size);
         }
+    }
+
+    /// Point `i` of a run as [`Self::lit_run`] looks it up: where it falls in the map, the
+    /// nearness recorded there and the point's threshold (for traces).
+    fn texel(&self, lookup: &Lookup, i: usize, r: usize, batch: &mut Located) -> (f32, f32, Option<f32>, f32) {
+        self.locate(lookup, i, 1, r, batch);
+        let (u, v, threshold) = (batch.x[0][0], batch.y[0][0], batch.threshold[0][0]);
+        let n = self.size as f32;
+        let inside = (0.0..n).contains(&u) && (0.0..n).contains(&v);
+        let stride = (self.size + PAD) as usize;
+        let map = inside.then(|| self.nearness[v as usize * stride + u as usize]).filter(|m| m.is_finite());
+        (u, v, map, threshold)
     }
 
     /// Receiver-plane depth bias (Isidoro 2006): each texel of the kernel is compared with
@@ -531,6 +558,17 @@ impl Located {
     }
 }
 
+/// What the points of one run share when they are looked up in a map.
+#[derive(Debug, Clone, Copy)]
+struct Lookup {
+    l0: [f32; 4],
+    dl: [f32; 4],
+    b0: f32,
+    b1: f32,
+    bs: f32,
+    receiver_plane: Option<(f32, f32)>,
+}
+
 /// A light sample's maps: one, or a cube of six.
 enum LightMaps {
     Single(Box<DepthMap>),
@@ -638,21 +676,40 @@ impl LightMaps {
         }
     }
 
-    /// Pass 2 along a run (see [`DepthMap::lit_run`]); a cube's run is cut where the face
-    /// holding its points changes.
+    /// Pass 2 along a run (see [`DepthMap::lit_run`]).
     fn lit_run(&self, h0: DVec4, step: DVec4, bias: &Bias, r: usize, batch: &mut Located, out: &mut [f32]) {
+        self.pieces(h0, step, out.len(), |map, start, a, b| map.lit_run(start, step, bias, r, batch, &mut out[a..b]));
+    }
+
+    /// Where each of a run's `len` points falls in the maps, as [`Self::lit_run`] looks it up.
+    fn texels(&self, h0: DVec4, step: DVec4, bias: &Bias, r: usize, len: usize) -> Vec<Texel> {
+        let (mut texels, mut batch) = (Vec::with_capacity(len), Box::<Located>::default());
+        self.pieces(h0, step, len, |map, start, a, b| {
+            let lookup = map.lookup(start, step, bias, r);
+            for i in a..b {
+                let (u, v, map, threshold) = map.texel(&lookup, i - a, r, &mut batch);
+                texels.push(Texel { x: i as u32, u, v, map, threshold });
+            }
+        });
+        texels
+    }
+
+    /// Calls `f(map, start, a, b)` for the pieces `a..b` of a run of `len` points starting at
+    /// `h0`, each with the map its points fall in and its first point: one piece, or for a
+    /// cube, a piece wherever the face holding the points changes.
+    fn pieces(&self, h0: DVec4, step: DVec4, len: usize, mut f: impl FnMut(&DepthMap, DVec4, usize, usize)) {
         match self {
-            LightMaps::Single(map) => map.lit_run(h0, step, bias, r, batch, out),
+            LightMaps::Single(map) => f(map, h0, 0, len),
             LightMaps::Cube(faces, s) => {
                 let face = |i: usize| {
                     let h = h0 + step * i as f64;
                     cube_face(h.truncate() / h.w - *s)
                 };
                 let mut a = 0;
-                while a < out.len() {
-                    let f = face(a);
-                    let b = (a + 1..out.len()).find(|&i| face(i) != f).unwrap_or(out.len());
-                    faces[f].lit_run(h0 + step * a as f64, step, bias, r, batch, &mut out[a..b]);
+                while a < len {
+                    let k = face(a);
+                    let b = (a + 1..len).find(|&i| face(i) != k).unwrap_or(len);
+                    f(&faces[k], h0 + step * a as f64, a, b);
                     a = b;
                 }
             }
@@ -735,6 +792,14 @@ impl<'a> Williams<'a> {
     /// along the line rather than recomputed. The slope-scaled bias follows the receiver's
     /// depth slope in each map, as `glPolygonOffset` does.
     fn lookup_run(&self, light: usize, s: usize, line: u32, run: &Run, batch: &mut Located, out: &mut [f32]) {
+        let (h0, step, bias) = self.run_start(line, run);
+        let map = &self.maps[self.ctx.sample_index(light, s)];
+        map.lit_run(h0, step, &bias, self.kernel_radius(), batch, out);
+    }
+
+    /// A run's first point and step on its polygon's plane (homogeneous, `w > 0`), and the
+    /// bias at its points.
+    fn run_start(&self, line: u32, run: &Run) -> (DVec4, DVec4, Bias) {
         let poly = run.poly as usize;
         let view = self.ctx.view;
         let plane = &self.ctx.scene.polygons[poly].plane;
@@ -759,8 +824,7 @@ impl<'a> Williams<'a> {
             normal,
             receiver_plane: self.options.receiver_plane,
         };
-        let map = &self.maps[self.ctx.sample_index(light, s)];
-        map.lit_run(h0 * flip, step * flip, &bias, self.kernel_radius(), batch, out);
+        (h0 * flip, step * flip, bias)
     }
 
     /// Seed 002: the N×N PCF term of every visible pixel in a screen-sized buffer (1 where
@@ -827,7 +891,13 @@ pub fn seed_gaussian_taps() -> Vec<(i64, f32)> {
 
 impl ShadowStage for Williams<'_> {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
-        Box::new(Walker { stage: self, batch: Box::default(), lookups: 0, last: (0, 0, 0) })
+        Box::new(Walker {
+            stage: self,
+            batch: Box::default(),
+            lookups: 0,
+            last: (0, 0, 0),
+            last_run: (0, 0, 0, Run { x0: 0, x1: 0, poly: 0 }),
+        })
     }
 }
 
@@ -838,6 +908,8 @@ struct Walker<'s> {
     lookups: u64,
     /// The last run and the texels compared per pixel.
     last: (u32, u32, u32),
+    /// The last run's light, sample and line, and the run.
+    last_run: (usize, usize, u32, Run),
 }
 
 impl ShadowWalker for Walker<'_> {
@@ -854,14 +926,24 @@ impl ShadowWalker for Walker<'_> {
         let width = 2 * st.kernel_radius() as u32 + 1;
         self.lookups += lit.len() as u64;
         self.last = (run.x0, run.x1, width * width);
+        self.last_run = (light, sample, line, *run);
     }
 
     fn decision(&self) -> Decision {
         let (a, b, texels) = self.last;
+        let st = self.stage;
+        let (light, sample, line, run) = self.last_run;
+        let (h0, step, bias) = st.run_start(line, &run);
+        let r = st.kernel_radius();
+        let map = &st.maps[st.ctx.sample_index(light, sample)];
+        let mut points = map.texels(h0, step, &bias, r, (run.x1 - run.x0) as usize);
+        for t in &mut points {
+            t.x += run.x0;
+        }
         Decision {
             tested: vec![(a, b, texels)],
             note: format!("{} map lookup(s) of {texels} texel(s) each", b - a),
-            detail: super::Detail::None,
+            detail: super::Detail::Texels { size: st.options.map_size, kernel: 2 * r as u32 + 1, texels: points },
         }
     }
 

@@ -15,7 +15,7 @@
 //! moves the first light (a point, spot or area light's position or corner; a directional
 //! light then shines from there toward the middle of the scene).
 //!
-//! [`serve`] answers on 127.0.0.1 only, with `tiny_http`; [`export`] writes the same page as
+//! [`serve`] answers on 127.0.0.1 only, with `axum`; [`export`] writes the same page as
 //! static files with every line precomputed, readable straight from disk.
 
 use super::trace::{trace, trace_lines, LineTrace};
@@ -219,8 +219,14 @@ impl Explorer {
             pairs(query).find(|(k, _)| k == "line").ok_or_else(|| Error::Invalid("missing parameter 'line'".into()))?.1;
         let line: u32 = line.parse().map_err(|_| Error::Invalid(format!("line '{line}' is not a line number")))?;
         let scene = self.scene_for(&r)?;
-        trace(&scene, line, r.shadows, &ShadowOptions::default())
+        trace(&scene, line, r.shadows, &traced())
     }
+}
+
+/// The stages' options for a trace: the defaults, keeping what the stages can tell about
+/// their polygons (Bouknight-Kelley's pairs per receiver, the outlines).
+fn traced() -> ShadowOptions {
+    ShadowOptions { keep_outlines: true, ..ShadowOptions::default() }
 }
 
 /// What the page shows of a render: size, times, counters, the stage's polygons on screen
@@ -327,46 +333,38 @@ fn point(value: &str) -> Result<DVec3> {
 }
 
 /// Serves the page on `127.0.0.1:port` (0: any free port) until the process ends, calling
-/// `ready` with the address once it listens. Requests are answered on several threads.
+/// `ready` with the address once it listens. Requests are answered on a thread pool, the
+/// engine's work off the server's own threads.
 pub fn serve(explorer: Explorer, port: u16, ready: impl FnOnce(&str)) -> Result<()> {
-    let server = tiny_http::Server::http(("127.0.0.1", port))
-        .map_err(|e| Error::Invalid(format!("cannot listen on 127.0.0.1:{port}: {e}")))?;
-    let address = match server.server_addr() {
-        tiny_http::ListenAddr::IP(a) => format!("http://{a}/"),
-        #[allow(unreachable_patterns)]
-        _ => return Err(Error::Internal("the server is not on an IP address".into())),
-    };
-    ready(&address);
-    let (server, explorer) = (Arc::new(server), Arc::new(explorer));
-    let workers: Vec<_> = (0..4)
-        .map(|_| {
-            let (server, explorer) = (server.clone(), explorer.clone());
-            std::thread::spawn(move || {
-                for request in server.incoming_requests() {
-                    answer(&explorer, request);
-                }
-            })
-        })
-        .collect();
-    for w in workers {
-        let _ = w.join();
-    }
-    Ok(())
-}
-
-fn answer(explorer: &Explorer, request: tiny_http::Request) {
-    let r = if *request.method() == tiny_http::Method::Get {
-        explorer.handle(request.url())
-    } else {
-        Response::error(405, "only GET is served")
-    };
-    let header = tiny_http::Header::from_bytes("Content-Type", r.content_type).ok();
-    let mut response = tiny_http::Response::from_data(r.body).with_status_code(r.status);
-    if let Some(h) = header {
-        response.add_header(h);
-    }
-    // A client gone before the answer is its own affair.
-    let _ = request.respond(response);
+    use axum::http::{header, Method, StatusCode, Uri};
+    let failed = |what: &str, e: std::io::Error| Error::Invalid(format!("{what}: {e}"));
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_io()
+        .build()
+        .map_err(|e| failed("cannot start the server", e))?;
+    runtime.block_on(async move {
+        let listener = tokio::net::TcpListener::bind(("127.0.0.1", port))
+            .await
+            .map_err(|e| failed(&format!("cannot listen on 127.0.0.1:{port}"), e))?;
+        let address = listener.local_addr().map_err(|e| failed("the server has no address", e))?;
+        ready(&format!("http://{address}/"));
+        let explorer = Arc::new(explorer);
+        let app = axum::Router::new().fallback(move |method: Method, uri: Uri| {
+            let explorer = explorer.clone();
+            async move {
+                let r = if method == Method::GET {
+                    let url = uri.path_and_query().map_or("/", |p| p.as_str()).to_owned();
+                    let answer = tokio::task::spawn_blocking(move || explorer.handle(&url)).await;
+                    answer.unwrap_or_else(|e| Response::error(500, &format!("the engine failed: {e}")))
+                } else {
+                    Response::error(405, "only GET is served")
+                };
+                let status = StatusCode::from_u16(r.status).unwrap_or(StatusCode::INTERNAL_SERVER_ERROR);
+                (status, [(header::CONTENT_TYPE, r.content_type)], r.body)
+            }
+        });
+        axum::serve(listener, app).await.map_err(|e| failed("the server stopped", e))
+    })
 }
 
 /// Writes the page with every line of every applicable stage precomputed into `dir`, at
@@ -394,7 +392,7 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
         // The visibility part of a line is the same for every stage: written once.
         let first = watkins.is_empty();
         let mut decisions = String::new();
-        trace_lines(&explorer.scene_for(&r)?, 0..height, shadows, &ShadowOptions::default(), |mut t| {
+        trace_lines(&explorer.scene_for(&r)?, 0..height, shadows, &traced(), |mut t| {
             let _ = writeln!(decisions, "umbraDecisions({:?}, {}, {});", name, t.line, to_json(&t.decisions)?);
             if first {
                 t.decisions.clear();

@@ -88,6 +88,7 @@ async function checkLive(browser, url) {
   assert.match(await page.textContent("#pixel"), /^Pixel \(210, 440\)/);
   const atClick = trace(440, "bouknight-kelley");
   assert.equal((await tableRows(page, "aet")).length, atClick.active.length, "active edges after a click");
+  assert.match(await page.textContent("#stage-extra"), /the sphere prefilter kept \d+ caster\(s\)/);
   if (shots) await page.screenshot({ path: join(shots, "explore-bouknight-kelley.png"), fullPage: true });
 
   // Switching the stage changes the panels.
@@ -105,6 +106,11 @@ async function checkLive(browser, url) {
   await page.locator("#overlay").click({ position: { x: 305.5 * scale, y: 440.5 * scale } });
   await page.waitForFunction(() => /^Pixel \(305, 440\)/.test(document.getElementById("pixel").textContent));
   if (shots) await page.screenshot({ path: join(shots, "explore-crow.png"), fullPage: true });
+  await page.selectOption("#stage", "williams");
+  await page.waitForSelector('#stage-panel[data-stage="williams"]', { timeout: 60000 });
+  await ready(page);
+  assert.match(await page.textContent("#stage-extra"), /A 2048² map, 3×3 texels compared per pixel/);
+  if (shots) await page.screenshot({ path: join(shots, "explore-williams.png"), fullPage: true });
 
   // Moving the light renders again.
   const src = await page.getAttribute("#frame", "src");
@@ -138,8 +144,9 @@ async function checkLive(browser, url) {
     const asks = [];
     for (let i = 0; i < 24; i++) {
       const stage = ["bouknight-kelley", "crow", "ray-cast", "williams"][i % 4];
-      asks.push(fetch(`api/trace?line=${10 * i}&shadows=${stage}&width=320&height=240`).then((r) => r.status));
-      asks.push(fetch(`api/frame?shadows=${stage}&width=${100 + i}&height=80`).then((r) => r.status));
+      for (const u of [`api/trace?line=${10 * i}&shadows=${stage}&width=320&height=240`, `api/frame?shadows=${stage}&width=${100 + i}&height=80`]) {
+        asks.push(fetch(u, { signal: AbortSignal.timeout(30000) }).then((r) => r.status, (e) => `${u}: ${e.name}`));
+      }
     }
     return Promise.all(asks);
   });
@@ -172,6 +179,8 @@ async function checkExported(browser) {
   }
 }
 
+// A hung request fails the test instead of hanging CI.
+setTimeout(() => { console.error("explore browser test: timed out"); process.exit(1); }, 300000).unref();
 const [server, url] = await startServer();
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM || "/usr/bin/chromium",

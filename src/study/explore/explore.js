@@ -394,6 +394,7 @@ function drawStage(t) {
   }
   $("stage-pick").textContent =
     `Run ${d.x0}..${d.x1} on polygon ${d.polygon}, light ${d.light} sample ${d.sample}: ${d.decision.note}`;
+  $("stage-extra").textContent = extra(d);
   const W = c.width, left = 40, X = (x) => left + ((x - d.x0) / Math.max(1, d.x1 - d.x0)) * (W - left - 8);
   const bar = (a, b, row, fill, label) => {
     g.fillStyle = fill;
@@ -422,6 +423,8 @@ function drawStage(t) {
     name(row, "count");
     for (const [a, b, n] of detail.counts) bar(a, b, row, n === 0 ? "rgba(250, 200, 40, 0.9)" : "#243a73", `${n}`);
     row++;
+  } else if (detail.kind === "texels") {
+    drawTexels(g, detail, d, X, row, c.height);
   } else if (detail.kind === "covers") {
     for (const cv of detail.covers) { name(row, `#${cv.polygon}`); bar(cv.start, cv.end, row++, "rgba(250, 200, 40, 0.7)", "lit detail polygon"); }
   }
@@ -430,12 +433,70 @@ function drawStage(t) {
   g.fillText(`${d.x1}`, W - 30, c.height - 4);
 }
 
+// What the stage found before the walk, in words.
+function extra(d) {
+  const detail = d.decision.detail;
+  if (detail.kind === "segments" && detail.pairs) {
+    const p = detail.pairs;
+    const from = p.shadow_polygons.map(([tag, caster]) => `#${tag} from polygon ${caster}`);
+    return `Steps 1-3 for polygon ${d.polygon}: the sphere prefilter kept ${p.kept.length} caster(s) ` +
+      `[${p.kept.join(", ")}]; ${p.behind.length} lie wholly behind it as the light sees it` +
+      `${p.behind.length ? ` [${p.behind.join(", ")}]` : ""}; the others project to ` +
+      `${from.length} shadow polygon(s) on it: ${from.join(", ") || "none"}.`;
+  }
+  if (detail.kind === "texels") {
+    const inside = detail.texels.filter((t) => t.map !== null);
+    return `A ${detail.size}² map, ${detail.kernel}×${detail.kernel} texels compared per pixel. ` +
+      `Below: the nearness the map holds at each pixel's texel (dots) and the pixel's own, with the ` +
+      `bias (line); where the map holds more, the texel hides the point. ${inside.length} of ` +
+      `${detail.texels.length} pixels fall on drawn texels. Right: their path across the map.`;
+  }
+  return "";
+}
+
+// Williams: the map's nearness at each pixel's texel against the point's threshold, and the
+// pixels' path across the map.
+function drawTexels(g, detail, d, X, row, height) {
+  const ts = detail.texels, top = 6 + row * 18, bottom = height - 16;
+  const values = ts.flatMap((t) => [t.map, t.threshold]).filter((v) => v !== null && Number.isFinite(v));
+  if (!values.length) return;
+  let lo = Math.min(...values), hi = Math.max(...values);
+  if (hi - lo < 1e-12) { lo -= 1e-6; hi += 1e-6; }
+  const Y = (v) => bottom - ((v - lo) / (hi - lo)) * (bottom - top);
+  const width = g.canvas.width, plotRight = width - 130;
+  const Xp = (x) => X(x) * (plotRight / width);
+  g.strokeStyle = "rgba(200, 150, 0, 0.95)";
+  g.beginPath();
+  ts.forEach((t, i) => Number.isFinite(t.threshold) &&
+    (i ? g.lineTo(Xp(t.x + 0.5), Y(t.threshold)) : g.moveTo(Xp(t.x + 0.5), Y(t.threshold))));
+  g.stroke();
+  for (const t of ts) {
+    if (t.map === null) continue;
+    g.fillStyle = t.map > t.threshold ? "#243a73" : "rgba(36, 58, 115, 0.35)";
+    g.fillRect(Xp(t.x + 0.5) - 1.5, Y(t.map) - 1.5, 3, 3);
+  }
+  g.fillStyle = "#4a5160";
+  g.fillText("nearness", 2, top + 10);
+  // The path across the map, in a square at the right.
+  const side = Math.min(110, bottom - top), x0 = width - side - 8, y0 = top;
+  g.strokeStyle = "#bbb";
+  g.strokeRect(x0, y0, side, side);
+  g.fillStyle = "rgba(36, 58, 115, 0.8)";
+  for (const t of ts) {
+    if (!Number.isFinite(t.u) || !Number.isFinite(t.v)) continue;
+    g.fillRect(x0 + (t.u / detail.size) * side - 1, y0 + (t.v / detail.size) * side - 1, 2, 2);
+  }
+  g.fillStyle = "#4a5160";
+  g.fillText("map", x0, y0 + side + 11);
+}
+
 // Rows of the stage canvas: the lit row and the detail's own.
 function rowsOf(detail) {
   switch (detail.kind) {
     case "segments": return 2 + detail.covers.length + Math.max(0, ...detail.segments.map((s) => s.depth));
     case "counts": return 2 + detail.adds.length;
     case "covers": return 1 + detail.covers.length;
+    case "texels": return 9;
     default: return 1;
   }
 }
