@@ -202,7 +202,10 @@ struct CompareArgs {
     /// Output folder.
     #[arg(long, default_value = "compare")]
     out: PathBuf,
-    /// Timed runs per method; the median is reported.
+    /// Untimed renders per method first (page faults, caches).
+    #[arg(long, default_value_t = 1)]
+    warmup: usize,
+    /// Timed runs per method; the median, least and greatest are reported.
     #[arg(long, default_value_t = 3)]
     runs: usize,
     #[command(flatten)]
@@ -492,19 +495,28 @@ fn run(cli: Cli) -> umbra::Result<()> {
                 visibility: if a.visibility.is_empty() { d.visibility } else { a.visibility },
                 shadows: if a.shadows.is_empty() { d.shadows } else { a.shadows },
                 shadow_options: a.shadow.options(false)?,
+                warmup: a.warmup,
                 runs: a.runs,
                 out: a.out.clone(),
                 progress: true,
             };
             let report = compare(&scene, &scene_name(&a.scene), &opts)?;
+            let mut table = String::new();
             for r in &report.results {
-                eprintln!(
-                    "{:>9} + {:<26} {:>9.1} ms  {:>8} / {:<8} wrong  {}",
-                    r.visibility, r.shadows, r.time_ms, r.wrong_pixels, r.interior_pixels, r.status
+                table += &format!(
+                    "{:>9} + {:<26} {:>9.1} ms ({:.1}–{:.1})  {:>8} / {:<8} wrong  {}\n",
+                    r.visibility,
+                    r.shadows,
+                    r.time.median_ms,
+                    r.time.min_ms,
+                    r.time.max_ms,
+                    r.wrong_pixels,
+                    r.interior_pixels,
+                    r.status
                 );
             }
-            eprintln!("report: {}", a.out.join("report.html").display());
-            Ok(())
+            stdout(&table)?;
+            say(&format!("wrote {}", a.out.join("report.html").display()))
         }
         Command::Bench(a) => {
             let scene = a.shadow.load(&a.scene)?;
@@ -562,14 +574,15 @@ fn run(cli: Cli) -> umbra::Result<()> {
                 counter: a.counter,
                 out: a.out.clone(),
             };
+            let mut table = String::new();
             for p in scale(&opts)? {
-                eprintln!(
-                    "{:>10} {:>9} + {:<26} {:>9.1} ms  {}",
-                    p.value, p.visibility, p.shadows, p.time_ms, p.counter
+                table += &format!(
+                    "{:>10} {:>9} + {:<26} {:>9.1} ms ({:.1}–{:.1})  {}\n",
+                    p.value, p.visibility, p.shadows, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
                 );
             }
-            eprintln!("written: {}", a.out.display());
-            Ok(())
+            stdout(&table)?;
+            say(&format!("wrote {}", a.out.display()))
         }
         Command::Trace(a) => {
             let scene = a.shadow.load(&a.scene)?;

@@ -54,6 +54,17 @@ fn compare_reports_every_method_and_a_valid_page() {
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
     assert_eq!(json["results"].as_array().unwrap().len(), report.results.len());
     assert_eq!(std::fs::read_to_string(out.join("results.csv")).unwrap().lines().count(), report.results.len() + 1);
+    // Every report says what it is: program, machine, date, options; and the spread.
+    let about = &json["about"];
+    assert_eq!(about["umbra"], env!("CARGO_PKG_VERSION"));
+    assert!(about["cores"].as_u64().unwrap() >= 1 && about["date_utc"].as_str().unwrap().starts_with("20"));
+    assert!(about["options"].as_str().unwrap().contains("crow_count"));
+    assert!(html.contains(about["date_utc"].as_str().unwrap()));
+    for r in json["results"].as_array().unwrap().iter().filter(|r| r["status"] == "ok") {
+        let (lo, mid, hi) =
+            (r["min_ms"].as_f64().unwrap(), r["median_ms"].as_f64().unwrap(), r["max_ms"].as_f64().unwrap());
+        assert!(lo <= mid && mid <= hi && lo > 0.0, "{r}");
+    }
 }
 
 /// A hand-worked scanline. The camera at the origin looks down −z with a 90° field of view
@@ -136,6 +147,11 @@ fn scale_writes_csv_and_plots() {
     let z: Vec<u64> = points.iter().filter(|p| p.visibility == "zbuffer").map(|p| p.counter).collect();
     assert!(z[2] > 10 * z[0], "{z:?}");
     assert_eq!(std::fs::read_to_string(out.join("scale.csv")).unwrap().lines().count(), 7);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("scale.json")).unwrap()).unwrap();
+    assert_eq!(json["points"].as_array().unwrap().len(), 6);
+    assert!(json["about"]["options"].as_str().unwrap().starts_with("sweep quads"));
+    assert!(points.iter().all(|p| p.time.min_ms <= p.time.median_ms && p.time.median_ms <= p.time.max_ms));
     for svg in ["time.svg", "counter.svg"] {
         assert!(std::fs::read_to_string(out.join(svg)).unwrap().starts_with("<svg"));
     }

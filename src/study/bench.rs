@@ -5,7 +5,7 @@
 //! the pipeline reports, and the process's peak resident memory so far.
 
 use crate::error::{Error, Result};
-use crate::render::{render, RenderOptions};
+use crate::render::{render, RenderOptions, Rendered};
 use crate::scene::Scene;
 use crate::shadow::{ShadowMethod, ShadowOptions};
 use crate::visibility::VisibilityMethod;
@@ -40,7 +40,7 @@ pub struct Spread {
 }
 
 impl Spread {
-    fn of(mut v: Vec<f64>) -> Spread {
+    pub(crate) fn of(mut v: Vec<f64>) -> Spread {
         v.sort_by(f64::total_cmp);
         let median_ms = if v.is_empty() { 0.0 } else { v[v.len() / 2] };
         Spread { median_ms, min_ms: v.first().copied().unwrap_or(0.0), max_ms: v.last().copied().unwrap_or(0.0) }
@@ -67,6 +67,40 @@ pub struct BenchRow {
     pub peak_rss_mb: f64,
 }
 
+/// One method measured: its frame and phases over the timed runs, and the last run.
+pub struct Measured {
+    /// The whole frame, as the caller sees it (`render` called and returned).
+    pub frame: Spread,
+    /// Every timed run's frame, in order.
+    pub times_ms: Vec<f64>,
+    /// Each phase the pipeline reports.
+    pub phases: BTreeMap<String, Spread>,
+    /// The last timed run's frame and statistics.
+    pub last: Rendered,
+}
+
+/// The measuring core of `bench`, `compare` and `scale`: `warmup` untimed renders, then
+/// `runs` (at least one) timed renders of `scene` in this process.
+pub fn measure(scene: &Scene, opts: &RenderOptions, warmup: usize, runs: usize) -> Result<Measured> {
+    for _ in 0..warmup {
+        render(scene, opts)?;
+    }
+    let (mut times_ms, mut phases) = (Vec::new(), BTreeMap::<String, Vec<f64>>::new());
+    let mut last = None;
+    for _ in 0..runs.max(1) {
+        let t = Instant::now();
+        let out = render(scene, opts)?;
+        times_ms.push(t.elapsed().as_secs_f64() * 1e3);
+        for (k, ms) in out.stats.time_ms.iter().filter(|(k, _)| **k != "total") {
+            phases.entry(k.to_string()).or_default().push(*ms);
+        }
+        last = Some(out);
+    }
+    let last = last.ok_or_else(|| Error::Internal("no timed run".into()))?;
+    let phases = phases.into_iter().map(|(k, v)| (k, Spread::of(v))).collect();
+    Ok(Measured { frame: Spread::of(times_ms.clone()), times_ms, phases, last })
+}
+
 /// Measures every visibility × shadow pair on `scene`; `progress` is told each row as it
 /// starts.
 pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<Vec<BenchRow>> {
@@ -83,24 +117,13 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
                 shadow_options: o.shadow_options.clone(),
                 ..RenderOptions::default()
             };
-            for _ in 0..o.warmup {
-                render(scene, &opts)?;
-            }
-            let (mut frames, mut phases) = (Vec::new(), BTreeMap::<String, Vec<f64>>::new());
-            for _ in 0..o.runs {
-                let t = Instant::now();
-                let out = render(scene, &opts)?;
-                frames.push(t.elapsed().as_secs_f64() * 1e3);
-                for (k, ms) in out.stats.time_ms.iter().filter(|(k, _)| **k != "total") {
-                    phases.entry(k.to_string()).or_default().push(*ms);
-                }
-            }
+            let m = measure(scene, &opts, o.warmup, o.runs)?;
             rows.push(BenchRow {
                 visibility: v.name().into(),
                 shadows: s.name().into(),
                 runs: o.runs,
-                frame: Spread::of(frames),
-                phases: phases.into_iter().map(|(k, v)| (k, Spread::of(v))).collect(),
+                frame: m.frame,
+                phases: m.phases,
                 peak_rss_mb: peak_rss_mb(),
             });
         }

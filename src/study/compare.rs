@@ -12,6 +12,7 @@ use crate::frame::Frame;
 use crate::render::{render, RenderOptions};
 use crate::scene::Scene;
 use crate::shadow::{ShadowMethod, ShadowOptions};
+use crate::study::bench::{measure, Spread};
 use crate::visibility::VisibilityMethod;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -27,7 +28,9 @@ pub struct CompareOptions {
     pub shadows: Vec<ShadowMethod>,
     /// Options every shadow stage gets.
     pub shadow_options: ShadowOptions,
-    /// Timed runs per method (the median is reported).
+    /// Untimed renders per method before the timed ones.
+    pub warmup: usize,
+    /// Timed runs per method (the median, least and greatest are reported).
     pub runs: usize,
     /// Output folder.
     pub out: PathBuf,
@@ -41,6 +44,7 @@ impl Default for CompareOptions {
             visibility: VisibilityMethod::ALL.to_vec(),
             shadows: ShadowMethod::ALL.to_vec(),
             shadow_options: ShadowOptions::default(),
+            warmup: 1,
             runs: 3,
             out: PathBuf::from("compare"),
             progress: false,
@@ -59,11 +63,12 @@ pub struct MethodResult {
     pub status: String,
     /// Whether the shadow stage is meant to be exact.
     pub exact: bool,
-    /// Median total time of the runs, milliseconds.
-    pub time_ms: f64,
-    /// Every run's total time.
+    /// The frame time over the timed runs (after the warm-up), milliseconds.
+    #[serde(flatten)]
+    pub time: Spread,
+    /// Every timed run's frame time.
     pub times_ms: Vec<f64>,
-    /// The median run's time per step.
+    /// The median time of each phase over the timed runs.
     pub step_ms: BTreeMap<String, f64>,
     /// Interior pixels of the reference (3×3 uniform in id and light values).
     pub interior_pixels: usize,
@@ -82,6 +87,8 @@ pub struct MethodResult {
 /// The whole comparison.
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
+    /// The program, machine, date and options.
+    pub about: super::About,
     /// The scene's name.
     pub scene: String,
     /// Image size.
@@ -94,12 +101,6 @@ pub struct Report {
     pub reference: String,
     /// One entry per method.
     pub results: Vec<MethodResult>,
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    s.get(s.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// Compares `got` with the reference at the reference's interior pixels: (interior, wrong,
@@ -164,32 +165,20 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
                 shadow_options: opts.shadow_options.clone(),
                 ..RenderOptions::default()
             };
-            let mut runs = Vec::new();
-            let mut status = "ok".to_string();
-            for _ in 0..opts.runs.max(1) {
-                match render(scene, &ropts) {
-                    Ok(r) => runs.push(r),
-                    Err(Error::NotApplicable(why)) => {
-                        status = format!("not applicable: {why}");
-                        break;
-                    }
-                    Err(e @ Error::Internal(_)) => {
-                        status = format!("failed: {e}");
-                        break;
-                    }
-                    Err(e) => return Err(e),
-                }
-                bar.advance(1);
-            }
-            let times: Vec<f64> = runs.iter().map(|r| r.stats.time_ms.get("total").copied().unwrap_or(0.0)).collect();
-            let med = median(&times);
-            let Some(run) = runs.iter().find(|r| r.stats.time_ms.get("total") == Some(&med)).or(runs.first()) else {
+            let (status, measured) = match measure(scene, &ropts, opts.warmup, opts.runs) {
+                Ok(m) => ("ok".to_string(), Some(m)),
+                Err(Error::NotApplicable(why)) => (format!("not applicable: {why}"), None),
+                Err(e @ Error::Internal(_)) => (format!("failed: {e}"), None),
+                Err(e) => return Err(e),
+            };
+            bar.advance(opts.runs.max(1) as u64);
+            let Some(m) = measured else {
                 results.push(MethodResult {
                     visibility: v.name().into(),
                     shadows: s.name().into(),
                     status,
                     exact: s.is_exact(),
-                    time_ms: 0.0,
+                    time: Spread { median_ms: 0.0, min_ms: 0.0, max_ms: 0.0 },
                     times_ms: Vec::new(),
                     step_ms: BTreeMap::new(),
                     interior_pixels: 0,
@@ -201,6 +190,7 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
                 });
                 continue;
             };
+            let run = &m.last;
             let (interior, wrong, diff_img) = diff(&reference, &run.frame);
             let counters = run
                 .stats
@@ -214,9 +204,9 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
                 shadows: s.name().into(),
                 status,
                 exact: s.is_exact(),
-                time_ms: med,
-                times_ms: times.clone(),
-                step_ms: run.stats.time_ms.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+                time: m.frame,
+                times_ms: m.times_ms.clone(),
+                step_ms: m.phases.iter().map(|(k, v)| (k.clone(), v.median_ms)).collect(),
                 interior_pixels: interior,
                 wrong_pixels: wrong,
                 error_share: wrong as f64 / interior.max(1) as f64,
@@ -228,6 +218,10 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
     }
     bar.finish();
     let report = Report {
+        about: super::About::now(format!(
+            "warmup {}, runs {}, shadow options {:?}",
+            opts.warmup, opts.runs, opts.shadow_options
+        )),
         scene: name.into(),
         width: scene.camera.width,
         height: scene.camera.height,
@@ -250,16 +244,20 @@ fn escape(s: &str) -> String {
 fn write_files(report: &Report, out: &Path) -> Result<()> {
     let json = serde_json::to_string_pretty(report).map_err(|e| Error::Internal(e.to_string()))?;
     write(&out.join("results.json"), &json)?;
-    let mut csv = String::from("visibility,shadows,status,exact,time_ms,interior_pixels,wrong_pixels,error_share\n");
+    let mut csv = String::from(
+        "visibility,shadows,status,exact,median_ms,min_ms,max_ms,interior_pixels,wrong_pixels,error_share\n",
+    );
     for r in &report.results {
         let _ = writeln!(
             csv,
-            "{},{},\"{}\",{},{:.3},{},{},{:.6}",
+            "{},{},\"{}\",{},{:.3},{:.3},{:.3},{},{},{:.6}",
             r.visibility,
             r.shadows,
             r.status.replace('"', "'"),
             r.exact,
-            r.time_ms,
+            r.time.median_ms,
+            r.time.min_ms,
+            r.time.max_ms,
             r.interior_pixels,
             r.wrong_pixels,
             r.error_share
@@ -276,7 +274,7 @@ fn html(report: &Report) -> String {
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>umbra compare: {scene}</title>\n<style>\n\
          body {{ font-family: sans-serif; margin: 1.5em; }}\ntable {{ border-collapse: collapse; font-size: 0.9em; }}\n\
          th, td {{ border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: right; }}\nth {{ cursor: pointer; background: #eee; }}\n\
-         td.name {{ text-align: left; }}\n.na {{ color: #888; }}\n.grid {{ display: flex; flex-wrap: wrap; gap: 1em; }}\n\
+         td.name {{ text-align: left; }}\n.na {{ color: #888; }}\n.noisy {{ color: #b3261e; }}\n.grid {{ display: flex; flex-wrap: wrap; gap: 1em; }}\n\
          figure {{ margin: 0; }}\nfigure img {{ width: 320px; image-rendering: pixelated; }}\nfigcaption {{ font-size: 0.85em; }}\n</style>\n</head>\n<body>\n\
          <h1>umbra compare: {scene}</h1>\n<p>{w}&times;{h} pixels, {n} polygons. Errors are counted at the reference's interior pixels \
          (3&times;3 neighbourhood uniform in face id and lit values); the reference is ray-cast visibility with ray-cast shadows. \
@@ -286,13 +284,28 @@ fn html(report: &Report) -> String {
         h = report.height,
         n = report.polygons
     );
-    h.push_str("<h2>Times and errors</h2>\n<p>Click a column to sort.</p>\n<table id=\"results\">\n<thead><tr>");
+    let a = &report.about;
+    let _ = writeln!(
+        h,
+        "<p class=\"about\">umbra {}, {} UTC; {} ({} cores, {} render threads, {}). Options: {}.</p>",
+        a.umbra,
+        a.date_utc,
+        escape(if a.cpu.is_empty() { "CPU not reported" } else { &a.cpu }),
+        a.cores,
+        a.threads,
+        escape(&a.os),
+        escape(&a.options)
+    );
+    h.push_str(
+        "<h2>Times and errors</h2>\n<p>Click a column to sort. Times are the median (least–greatest) of the \
+         timed runs after the warm-up; red where the runs spread over a fifth of the median (a busy machine).</p>\n<table id=\"results\">\n<thead><tr>",
+    );
     for col in [
         "visibility",
         "shadows",
         "status",
         "exact",
-        "time (ms)",
+        "time (ms): median (min–max)",
         "visibility (ms)",
         "shadow prepare (ms)",
         "shadow walk (ms)",
@@ -306,14 +319,22 @@ fn html(report: &Report) -> String {
     for r in &report.results {
         let step = |k: &str| r.step_ms.get(k).map_or(String::new(), |v| format!("{v:.1}"));
         let class = if r.status == "ok" { "" } else { " class=\"na\"" };
+        // A spread over a fifth of the median: the machine was busy; say so.
+        let noisy = if r.time.max_ms - r.time.min_ms > 0.2 * r.time.median_ms {
+            " class=\"noisy\" title=\"noisy: the runs spread over a fifth of the median\""
+        } else {
+            ""
+        };
         let _ = writeln!(
             h,
-            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td></tr>",
+            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td{noisy}>{:.1} ({:.1}–{:.1})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td></tr>",
             r.visibility,
             r.shadows,
             escape(&r.status),
             if r.exact { "yes" } else { "no" },
-            r.time_ms,
+            r.time.median_ms,
+            r.time.min_ms,
+            r.time.max_ms,
             step("visibility"),
             step("shadow_prepare"),
             step("shadow_walk"),
@@ -334,7 +355,7 @@ fn html(report: &Report) -> String {
         let _ = writeln!(
             h,
             "<figure><img src=\"{}\" alt=\"{label}\"><figcaption>{label}: {:.1} ms</figcaption></figure>\n<figure><img src=\"{}\" alt=\"{label} diff\"><figcaption>{label}: {} wrong</figcaption></figure>",
-            r.image, r.time_ms, r.diff, r.wrong_pixels
+            r.image, r.time.median_ms, r.diff, r.wrong_pixels
         );
     }
     h.push_str("</div>\n<h2>Counters</h2>\n");

@@ -11,3 +11,70 @@ pub mod explore;
 pub mod false_colour;
 pub mod scale;
 pub mod trace;
+
+/// What a measurement was taken with, recorded in every report: the program, the machine,
+/// the date and the options.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct About {
+    /// umbra's version.
+    pub umbra: &'static str,
+    /// When, in UTC (`YYYY-MM-DD HH:MM:SS`).
+    pub date_utc: String,
+    /// The CPU's model name (from `/proc/cpuinfo`; empty where the system does not say).
+    pub cpu: String,
+    /// Logical cores available to the process.
+    pub cores: usize,
+    /// Threads the engine renders with.
+    pub threads: usize,
+    /// Operating system and architecture.
+    pub os: String,
+    /// The options the measurement used, as the library sees them.
+    pub options: String,
+}
+
+impl About {
+    /// The program and machine now, with `options` described.
+    pub fn now(options: impl Into<String>) -> About {
+        let cpu = std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|t| t.lines().find(|l| l.starts_with("model name")).map(|l| l.to_owned()))
+            .and_then(|l| l.split_once(':').map(|(_, v)| v.trim().to_owned()))
+            .unwrap_or_default();
+        let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+        About {
+            umbra: env!("CARGO_PKG_VERSION"),
+            date_utc: utc(secs),
+            cpu,
+            cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            threads: rayon::current_num_threads(),
+            os: format!("{} {}", std::env::consts::OS, std::env::consts::ARCH),
+            options: options.into(),
+        }
+    }
+}
+
+/// Seconds since 1970 as a UTC date and time (the civil calendar from a day count, after
+/// Hinnant's `civil_from_days`).
+fn utc(secs: u64) -> String {
+    let (days, rest) = ((secs / 86_400) as i64, secs % 86_400);
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02} {:02}:{:02}:{:02}", rest / 3600, rest % 3600 / 60, rest % 60)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn utc_dates_are_the_calendar_s() {
+        assert_eq!(super::utc(0), "1970-01-01 00:00:00");
+        assert_eq!(super::utc(951_782_400), "2000-02-29 00:00:00");
+        assert_eq!(super::utc(1_795_000_000), "2026-11-18 11:06:40");
+    }
+}

@@ -6,9 +6,10 @@
 
 use crate::error::{Error, Result};
 use crate::generate;
-use crate::render::{render, RenderOptions};
+use crate::render::RenderOptions;
 use crate::scene::Scene;
 use crate::shadow::{ShadowMethod, ShadowOptions};
+use crate::study::bench::{measure, Spread};
 use crate::visibility::VisibilityMethod;
 #[cfg(feature = "plots")]
 use plotters::prelude::*;
@@ -126,13 +127,15 @@ pub struct Point {
     pub shadows: String,
     /// Polygons in the scene.
     pub polygons: usize,
-    /// Median total time, ms.
-    pub time_ms: f64,
+    /// The frame time over the timed runs (after one warm-up render), ms.
+    #[serde(flatten)]
+    pub time: Spread,
     /// The chosen counter.
     pub counter: u64,
 }
 
-/// Runs the sweep, writes `scale.csv`, and with the `plots` feature (on by default)
+/// Runs the sweep, writes `scale.csv` and `scale.json` (the points with what they were
+/// measured with), and with the `plots` feature (on by default)
 /// `time.svg` and `counter.svg`, into `out`.
 pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     std::fs::create_dir_all(&o.out).map_err(|e| Error::Io { path: o.out.clone(), source: e })?;
@@ -151,25 +154,17 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
                 shadow_options: o.shadow_options.clone(),
                 ..RenderOptions::default()
             };
-            let mut times = Vec::new();
-            let mut last = None;
-            for _ in 0..o.runs.max(1) {
-                let r = render(&scene, &opts)?;
-                times.push(r.stats.time_ms.get("total").copied().unwrap_or(0.0));
-                last = Some(r);
-            }
-            times.sort_by(f64::total_cmp);
-            let counter = last.map_or(0, |r| {
-                let counters = if kind == "shadow" { &r.stats.shadow_counters } else { &r.stats.visibility_counters };
-                known.extend(counters.iter().map(|(k, _)| k));
-                counters.get(name)
-            });
+            let m = measure(&scene, &opts, 1, o.runs)?;
+            let r = &m.last;
+            let counters = if kind == "shadow" { &r.stats.shadow_counters } else { &r.stats.visibility_counters };
+            known.extend(counters.iter().map(|(k, _)| k));
+            let counter = counters.get(name);
             points.push(Point {
                 value,
                 visibility: v.name().into(),
                 shadows: s.name().into(),
                 polygons: scene.polygons.len(),
-                time_ms: times[times.len() / 2],
+                time: m.frame,
                 counter,
             });
         }
@@ -184,16 +179,31 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
             )));
         }
     }
-    let mut csv = format!("{},visibility,shadows,polygons,time_ms,{}\n", o.sweep.name(), o.counter);
+    let mut csv = format!("{},visibility,shadows,polygons,median_ms,min_ms,max_ms,{}\n", o.sweep.name(), o.counter);
     for p in &points {
-        let _ =
-            writeln!(csv, "{},{},{},{},{:.3},{}", p.value, p.visibility, p.shadows, p.polygons, p.time_ms, p.counter);
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{:.3},{:.3},{:.3},{}",
+            p.value, p.visibility, p.shadows, p.polygons, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
+        );
     }
+    let about = super::About::now(format!(
+        "sweep {} over {:?}, {} timed run(s) after one warm-up, {}x{}, shadow options {:?}",
+        o.sweep.name(),
+        o.values,
+        o.runs.max(1),
+        o.width,
+        o.height,
+        o.shadow_options
+    ));
+    let json = serde_json::json!({ "about": about, "counter": o.counter, "points": points });
+    let path = o.out.join("scale.json");
+    std::fs::write(&path, json.to_string()).map_err(|e| Error::Io { path, source: e })?;
     let path = o.out.join("scale.csv");
     std::fs::write(&path, csv).map_err(|e| Error::Io { path, source: e })?;
     #[cfg(feature = "plots")]
     {
-        plot(&o.out.join("time.svg"), o, &points, "time (ms)", |p| p.time_ms)?;
+        plot(&o.out.join("time.svg"), o, &points, "time (ms)", |p| p.time.median_ms)?;
         plot(&o.out.join("counter.svg"), o, &points, &o.counter, |p| p.counter as f64)?;
     }
     Ok(points)
