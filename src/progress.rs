@@ -42,6 +42,23 @@ impl Bar {
         }
     }
 
+    /// A phase of the work begins: the bar shows its name and, from now on, ticks on its own
+    /// (so a long phase with no steps, such as a shadow stage's preparation, is not silent).
+    pub(crate) fn phase(&mut self, name: impl Into<String>) {
+        self.set_message(name);
+        #[cfg(feature = "cli")]
+        if self.bar.is_none() && self.enabled {
+            let target = indicatif::ProgressDrawTarget::stderr();
+            let bar = indicatif::ProgressBar::with_draw_target(Some(self.total), target);
+            if let Ok(style) = indicatif::ProgressStyle::with_template(self.template) {
+                bar.set_style(style);
+            }
+            bar.set_message(self.message.clone());
+            bar.enable_steady_tick(std::time::Duration::from_millis(500));
+            self.bar = Some(bar);
+        }
+    }
+
     /// `n` more steps done.
     pub(crate) fn advance(&mut self, n: u64) {
         self.done += n;

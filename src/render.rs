@@ -119,13 +119,16 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     };
     let view = View::new(&scene.camera);
     let (w, h) = (view.width, view.height);
+    let mut bar = crate::progress::Bar::new(opts.progress, h as u64, "{msg:40} {bar:30} {pos}/{len} lines {elapsed}");
 
     let t = Instant::now();
+    bar.phase("view: clipping and projecting");
     let screen = view.screen_polygons(scene);
     stats.visibility_counters.add("screen_polygons", screen.len() as u64);
     stats.time_ms.insert("view", ms(t.elapsed()));
 
     let t = Instant::now();
+    bar.phase(format!("visibility ({})", opts.visibility.name()));
     let visibility = opts.visibility.prepare(scene, &view, &screen, &mut stats.visibility_counters);
     let runs = crate::visibility::resolve(&*visibility, h, &mut stats.visibility_counters);
     let mut pixel_counters = opts.pixel_counters.then(|| {
@@ -141,6 +144,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     stats.time_ms.insert("visibility", ms(t.elapsed()));
 
     let t = Instant::now();
+    bar.phase(format!("shadow preparation ({})", opts.shadows.name()));
     let ctx = ShadowContext::new(scene, &view, &runs, opts.shadow_options.clone());
     stats.light_samples = ctx.samples.iter().map(Vec::len).sum();
     let shadows = opts.shadows.prepare(&ctx, &mut stats.shadow_counters)?;
@@ -168,8 +172,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
             tests: test_rows.as_mut().and_then(|rows| rows.next()),
         })
         .collect();
-    let mut bar = crate::progress::Bar::new(opts.progress, h as u64, "{msg} {bar:40} {pos}/{len} lines {elapsed}");
-    bar.set_message("rendering");
+    bar.phase("shadow walk and shading");
     let progress = Mutex::new(bar);
     let sample_count: usize = ctx.samples.iter().map(Vec::len).sum();
     let bands: Vec<(Counters, Duration, Duration)> = jobs

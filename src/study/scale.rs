@@ -203,52 +203,126 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     std::fs::write(&path, csv).map_err(|e| Error::Io { path, source: e })?;
     #[cfg(feature = "plots")]
     {
-        plot(&o.out.join("time.svg"), o, &points, "time (ms)", |p| p.time.median_ms)?;
-        plot(&o.out.join("counter.svg"), o, &points, &o.counter, |p| p.counter as f64)?;
+        let spread: Bounds = |p| (p.time.min_ms, p.time.max_ms);
+        plot(&o.out.join("time.svg"), o, &points, "frame time (ms)", |p| p.time.median_ms, Some(spread))?;
+        plot(&o.out.join("counter.svg"), o, &points, &o.counter, |p| p.counter as f64, None)?;
     }
     Ok(points)
 }
 
 /// A log-log plot of `y` against the swept value, one line per method.
 #[cfg(feature = "plots")]
-fn plot(path: &Path, o: &ScaleOptions, points: &[Point], label: &str, y: impl Fn(&Point) -> f64) -> Result<()> {
+/// What the x axis shows: what was rendered (the polygons of the scene), except on the
+/// sweeps whose parameter is not a polygon count.
+fn x_axis(o: &ScaleOptions) -> (&'static str, fn(&Point) -> f64) {
+    match o.sweep {
+        Sweep::Size => ("triangle size", |p| p.value),
+        Sweep::Resolution => ("pixels", |p| p.value * (p.value * 9.0 / 16.0).max(1.0).floor()),
+        _ => ("polygons rendered", |p| p.polygons as f64),
+    }
+}
+
+#[cfg(feature = "plots")]
+/// The least and greatest of a point's runs.
+type Bounds = fn(&Point) -> (f64, f64);
+
+#[cfg(feature = "plots")]
+/// A number as a tick label: short, without trailing zeros.
+fn tick(v: f64) -> String {
+    let a = v.abs();
+    if a >= 1e6 {
+        format!("{}M", trim(v / 1e6))
+    } else if a >= 1e4 {
+        format!("{}k", trim(v / 1e3))
+    } else {
+        trim(v)
+    }
+}
+
+#[cfg(feature = "plots")]
+fn trim(v: f64) -> String {
+    let s = format!("{v:.2}");
+    s.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+#[cfg(feature = "plots")]
+/// One plot: `y` of every method against what was rendered, on log axes, with the spread as
+/// error bars when `spread` gives it, and the legend beside the plot. A quantity that is zero
+/// everywhere gets a note instead of an empty plot.
+fn plot(
+    path: &Path,
+    o: &ScaleOptions,
+    points: &[Point],
+    label: &str,
+    y: impl Fn(&Point) -> f64,
+    spread: Option<Bounds>,
+) -> Result<()> {
     let err = |e: String| Error::Invalid(format!("{}: cannot draw the plot: {e}", path.display()));
-    let xs = points.iter().map(|p| p.value);
-    let (x0, x1) = (xs.clone().fold(f64::INFINITY, f64::min).max(1e-9), xs.fold(0.0, f64::max).max(1e-9));
-    let ys = points.iter().map(&y).filter(|v| *v > 0.0);
-    let (y0, y1) = (ys.clone().fold(f64::INFINITY, f64::min).clamp(1e-6, 1.0), ys.fold(1.0, f64::max));
-    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
+    let (x_label, x) = x_axis(o);
+    let root = SVGBackend::new(path, (860, 480)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{label} against {}", o.sweep.parameter()), ("sans-serif", 18))
-        .margin(12)
-        .x_label_area_size(36)
-        .y_label_area_size(60)
-        .build_cartesian_2d((x0 * 0.9..x1 * 1.1).log_scale(), (y0 * 0.8..y1 * 1.25).log_scale())
+    let positive: Vec<&Point> = points.iter().filter(|p| y(p) > 0.0 && x(p) > 0.0).collect();
+    if positive.is_empty() {
+        let note = format!("{label} is zero for every method and every {}: nothing to plot", o.sweep.parameter());
+        root.draw(&Text::new(note, (40, 230), ("sans-serif", 18))).map_err(|e| err(e.to_string()))?;
+        return root.present().map_err(|e| err(e.to_string()));
+    }
+    let low = |v: f64, w: f64| v.min(w);
+    let (x0, x1) = positive.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (low(a, x(p)), b.max(x(p))));
+    let range = |p: &Point| spread.map_or((y(p), y(p)), |f| f(p));
+    let (y0, y1) = positive.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
+        let (lo, hi) = range(p);
+        (low(a, lo.max(f64::MIN_POSITIVE)), b.max(hi))
+    });
+    let (plot_area, legend_area) = root.split_horizontally(640);
+    let mut chart = ChartBuilder::on(&plot_area)
+        .caption(format!("{label} against {x_label} ({} sweep)", o.sweep.name()), ("sans-serif", 17))
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d((x0 / 1.3..x1 * 1.3).log_scale(), (y0 / 1.3..y1 * 1.3).log_scale())
         .map_err(|e| err(e.to_string()))?;
-    chart.configure_mesh().x_desc(o.sweep.parameter()).y_desc(label).draw().map_err(|e| err(e.to_string()))?;
+    chart
+        .configure_mesh()
+        .light_line_style(TRANSPARENT)
+        .bold_line_style(BLACK.mix(0.08))
+        .x_labels(6)
+        .y_labels(6)
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .x_desc(x_label)
+        .y_desc(label)
+        .draw()
+        .map_err(|e| err(e.to_string()))?;
     for (i, &(v, s)) in o.methods.iter().enumerate() {
         let colour = Palette99::pick(i).to_rgba();
-        let series: Vec<(f64, f64)> = points
-            .iter()
-            .filter(|p| p.visibility == v.name() && p.shadows == s.name() && y(p) > 0.0)
-            .map(|p| (p.value, y(p)))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))
-            .map_err(|e| err(e.to_string()))?
-            .label(format!("{v} + {s}"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+        let mine: Vec<&Point> =
+            positive.iter().copied().filter(|p| p.visibility == v.name() && p.shadows == s.name()).collect();
+        let series: Vec<(f64, f64)> = mine.iter().map(|p| (x(p), y(p))).collect();
+        chart.draw_series(LineSeries::new(series.clone(), colour.stroke_width(2))).map_err(|e| err(e.to_string()))?;
         chart
             .draw_series(series.into_iter().map(|p| Circle::new(p, 3, colour.filled())))
             .map_err(|e| err(e.to_string()))?;
+        if spread.is_some() {
+            let bars = mine.iter().map(|p| {
+                let (lo, hi) = range(p);
+                PathElement::new(vec![(x(p), lo.max(y0)), (x(p), hi)], colour.stroke_width(1))
+            });
+            chart.draw_series(bars).map_err(|e| err(e.to_string()))?;
+        }
+        let row = 40 + 22 * i as i32;
+        legend_area
+            .draw(&PathElement::new(vec![(8, row), (30, row)], colour.stroke_width(2)))
+            .map_err(|e| err(e.to_string()))?;
+        legend_area
+            .draw(&Text::new(format!("{v} + {s}"), (36, row - 7), ("sans-serif", 13)))
+            .map_err(|e| err(e.to_string()))?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(e.to_string()))?;
+    if spread.is_some() {
+        let row = 52 + 22 * o.methods.len() as i32;
+        legend_area
+            .draw(&Text::new("bars: least to greatest run", (8, row), ("sans-serif", 12)))
+            .map_err(|e| err(e.to_string()))?;
+    }
     root.present().map_err(|e| err(e.to_string()))
 }
