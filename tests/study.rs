@@ -50,6 +50,10 @@ fn compare_reports_every_method_and_a_valid_page() {
         n += 1;
     }
     assert!(n > 20);
+    for chart in ["time-error.svg", "phases.svg"] {
+        assert!(html.contains(&format!("src=\"{chart}\"")), "{chart} is not in the report");
+        assert!(std::fs::read_to_string(out.join(chart)).unwrap().starts_with("<svg"));
+    }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
     assert_eq!(json["results"].as_array().unwrap().len(), report.results.len());
