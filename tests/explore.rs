@@ -52,6 +52,13 @@ fn the_frame_marks_no_pixel_for_exact_stages_and_is_an_image() {
     let williams = frame("williams");
     assert!(williams["stats"]["shadow_counters"]["map_lookups"].as_u64().unwrap() > 0);
     assert!(williams["differs"]["wrong_total"].as_u64().is_some());
+    // The shadow map's pictures: a point light's six cube faces, each a PNG.
+    assert_eq!(williams["pictures"].as_array().unwrap().len(), 6);
+    let face = explorer.handle("/api/picture?shadows=williams&width=200&height=150&index=5");
+    assert_eq!((face.status, face.content_type), (200, "image/png"));
+    assert!(image::load_from_memory(&face.body).unwrap().width() > 100);
+    let none = explorer.handle("/api/picture?shadows=williams&width=200&height=150&index=6");
+    assert!(none.status == 400 && json(&none)["error"].as_str().unwrap().contains("no such picture"));
     let image = explorer.handle("/api/image?shadows=crow&width=200&height=150");
     assert_eq!((image.status, image.content_type), (200, "image/png"));
     let png = image::load_from_memory(&image.body).unwrap();

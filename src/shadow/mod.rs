@@ -112,6 +112,11 @@ pub trait ShadowStage: Sync {
     /// A walker for one band of lines; it is called in increasing line order.
     fn walker(&self) -> Box<dyn ShadowWalker + '_>;
 
+    /// Pictures of what the stage built, for study (Williams: its depth maps).
+    fn pictures(&self) -> Vec<Picture> {
+        Vec::new()
+    }
+
     /// The screen outlines of the polygons the stage walks for the first sample of the first
     /// light (shadow polygons, detail polygons, shadow-volume polygons), when the options
     /// asked to keep them; for drawing over the image.
@@ -205,11 +210,28 @@ pub struct Cover {
     pub end: u32,
 }
 
+/// A picture of something a stage built for one light sample (a shadow map, a cube face).
+#[derive(Debug, Clone)]
+pub struct Picture {
+    /// The light.
+    pub light: usize,
+    /// Its sample.
+    pub sample: usize,
+    /// The cube face (0 for a single map).
+    pub face: usize,
+    /// The map's texels along each side (the picture may be smaller).
+    pub size: u32,
+    /// The picture.
+    pub image: image::GrayImage,
+}
+
 /// Where one pixel's point falls in a shadow map (Williams).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Texel {
     /// The pixel.
     pub x: u32,
+    /// The cube face it falls in (0 for a single map).
+    pub face: u8,
     /// Its texel coordinates in the map (a cube map: in the face it falls in).
     pub u: f32,
     /// Its texel coordinates in the map.

@@ -408,6 +408,23 @@ impl DepthMap {
         }
     }
 
+    /// The map as a picture at most `side` texels wide: nearer is brighter, black where
+    /// nothing was drawn.
+    fn picture(&self, side: u32) -> image::GrayImage {
+        let (n, stride) = (self.size, (self.size + PAD) as usize);
+        let step = n.div_ceil(side.max(1)).max(1);
+        let at = |x: u32, y: u32| self.nearness[(y * step) as usize * stride + (x * step) as usize];
+        let out = n.div_ceil(step);
+        let finite =
+            (0..out).flat_map(|y| (0..out).map(move |x| (x, y))).map(|(x, y)| at(x, y)).filter(|v| v.is_finite());
+        let (lo, hi) = finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        let span = (hi - lo).max(f32::MIN_POSITIVE);
+        image::GrayImage::from_fn(out, out, |x, y| {
+            let v = at(x, y);
+            image::Luma([if v.is_finite() { (40.0 + 215.0 * (v - lo) / span) as u8 } else { 0 }])
+        })
+    }
+
     /// Point `i` of a run as [`Self::lit_run`] looks it up: where it falls in the map, the
     /// nearness recorded there and the point's threshold (for traces).
     fn texel(&self, lookup: &Lookup, i: usize, r: usize, batch: &mut Located) -> (f32, f32, Option<f32>, f32) {
@@ -678,17 +695,19 @@ impl LightMaps {
 
     /// Pass 2 along a run (see [`DepthMap::lit_run`]).
     fn lit_run(&self, h0: DVec4, step: DVec4, bias: &Bias, r: usize, batch: &mut Located, out: &mut [f32]) {
-        self.pieces(h0, step, out.len(), |map, start, a, b| map.lit_run(start, step, bias, r, batch, &mut out[a..b]));
+        self.pieces(h0, step, out.len(), |map, _, start, a, b| {
+            map.lit_run(start, step, bias, r, batch, &mut out[a..b])
+        });
     }
 
     /// Where each of a run's `len` points falls in the maps, as [`Self::lit_run`] looks it up.
     fn texels(&self, h0: DVec4, step: DVec4, bias: &Bias, r: usize, len: usize) -> Vec<Texel> {
         let (mut texels, mut batch) = (Vec::with_capacity(len), Box::<Located>::default());
-        self.pieces(h0, step, len, |map, start, a, b| {
+        self.pieces(h0, step, len, |map, face, start, a, b| {
             let lookup = map.lookup(start, step, bias, r);
             for i in a..b {
                 let (u, v, map, threshold) = map.texel(&lookup, i - a, r, &mut batch);
-                texels.push(Texel { x: i as u32, u, v, map, threshold });
+                texels.push(Texel { x: i as u32, face: face as u8, u, v, map, threshold });
             }
         });
         texels
@@ -697,9 +716,9 @@ impl LightMaps {
     /// Calls `f(map, start, a, b)` for the pieces `a..b` of a run of `len` points starting at
     /// `h0`, each with the map its points fall in and its first point: one piece, or for a
     /// cube, a piece wherever the face holding the points changes.
-    fn pieces(&self, h0: DVec4, step: DVec4, len: usize, mut f: impl FnMut(&DepthMap, DVec4, usize, usize)) {
+    fn pieces(&self, h0: DVec4, step: DVec4, len: usize, mut f: impl FnMut(&DepthMap, usize, DVec4, usize, usize)) {
         match self {
-            LightMaps::Single(map) => f(map, h0, 0, len),
+            LightMaps::Single(map) => f(map, 0, h0, 0, len),
             LightMaps::Cube(faces, s) => {
                 let face = |i: usize| {
                     let h = h0 + step * i as f64;
@@ -709,7 +728,7 @@ impl LightMaps {
                 while a < len {
                     let k = face(a);
                     let b = (a + 1..len).find(|&i| face(i) != k).unwrap_or(len);
-                    f(&faces[k], h0 + step * a as f64, a, b);
+                    f(&faces[k], k, h0 + step * a as f64, a, b);
                     a = b;
                 }
             }
@@ -890,6 +909,21 @@ pub fn seed_gaussian_taps() -> Vec<(i64, f32)> {
 }
 
 impl ShadowStage for Williams<'_> {
+    fn pictures(&self) -> Vec<super::Picture> {
+        let mut out = Vec::new();
+        for (light, sample, _) in self.ctx.all_samples() {
+            let maps = &self.maps[self.ctx.sample_index(light, sample)];
+            let faces: Vec<&DepthMap> = match maps {
+                LightMaps::Single(map) => vec![map],
+                LightMaps::Cube(faces, _) => faces.iter().collect(),
+            };
+            for (face, map) in faces.into_iter().enumerate() {
+                out.push(super::Picture { light, sample, face, size: map.size, image: map.picture(512) });
+            }
+        }
+        out
+    }
+
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
         Box::new(Walker {
             stage: self,

@@ -10,6 +10,7 @@
 //! | `GET api/frame?shadows=S&width=W&height=H[&light=x,y,z]` | a render: times, counters, the stage's polygons on screen, the pixels where it differs from ray-cast |
 //! | `GET api/image?…` (the same parameters) | that render as PNG |
 //! | `GET api/trace?line=Y&…` | [`LineTrace`]: what `umbra trace --json` prints for line `Y` |
+//! | `GET api/picture?index=K&…` | picture `K` of the frame's `pictures` (Williams: a shadow map) as PNG |
 //!
 //! A bad request gets status 400 and `{"error": "…"}`, which the page shows. `light=x,y,z`
 //! moves the first light (a point, spot or area light's position or corner; a directional
@@ -83,10 +84,12 @@ struct Request {
     light: Option<DVec3>,
 }
 
-/// A render, kept for the image request that follows it.
+/// A render, kept for the image requests that follow it.
 struct Shown {
     request: Request,
     png: Vec<u8>,
+    /// The stage's pictures (Williams: its shadow maps), as PNG.
+    pictures: Vec<Vec<u8>>,
     summary: Value,
 }
 
@@ -116,6 +119,7 @@ impl Explorer {
                 self.request(query).and_then(|r| self.show(&r)).map(|s| Response::ok("image/png", s.png.clone()))
             }
             "api/trace" => self.trace(query).map(|t| Response::json(&t)),
+            "api/picture" => self.picture(query),
             _ => return Response::error(404, &format!("no such page: {path}")),
         };
         answer.unwrap_or_else(|e| Response::error(400, &e.to_string()))
@@ -152,7 +156,7 @@ impl Explorer {
                 "width" => r.width = side("width", &value)?,
                 "height" => r.height = side("height", &value)?,
                 "light" => r.light = Some(point(&value)?),
-                "line" => {}
+                "line" | "index" => {}
                 _ => return Err(Error::Invalid(format!("unknown parameter '{key}'"))),
             }
         }
@@ -199,8 +203,22 @@ impl Explorer {
         let got = render(&scene, &opts(r.shadows))?;
         let reference = render(&scene, &opts(ShadowMethod::RayCast))?;
         let png = crate::frame::encode_png(&got.frame.color_image(None))?;
-        let summary = summary(&scene, r, &got, &reference);
-        let shown = Arc::new(Shown { request: r.clone(), png, summary });
+        let mut summary = summary(&scene, r, &got, &reference);
+        // Only the shadow map has pictures; other stages are not prepared a second time.
+        let made = match r.shadows {
+            ShadowMethod::Williams => super::trace::pictures(&scene, r.shadows, &traced())?,
+            _ => Vec::new(),
+        };
+        let pictures = made
+            .iter()
+            .map(|p| crate::frame::encode_png(&image::DynamicImage::ImageLuma8(p.image.clone()).to_rgb8()))
+            .collect::<Result<_>>()?;
+        summary["pictures"] = made
+            .iter()
+            .map(|p| json!({ "light": p.light, "sample": p.sample, "face": p.face, "size": p.size }))
+            .collect::<Vec<_>>()
+            .into();
+        let shown = Arc::new(Shown { request: r.clone(), png, pictures, summary });
         let mut kept = self.lock();
         kept.push_front(shown.clone());
         kept.truncate(CACHE);
@@ -210,6 +228,16 @@ impl Explorer {
     fn lock(&self) -> std::sync::MutexGuard<'_, VecDeque<Arc<Shown>>> {
         // A panic while holding the lock cannot leave the cache inconsistent: use it anyway.
         self.shown.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// One of the stage's pictures, by its index in the frame's `pictures`.
+    fn picture(&self, query: &str) -> Result<Response> {
+        let shown = self.show(&self.request(query)?)?;
+        let index = pairs(query).find(|(k, _)| k == "index").map_or(Ok(0), |(_, v)| v.parse::<usize>());
+        match index.ok().and_then(|i| shown.pictures.get(i)) {
+            Some(png) => Ok(Response::ok("image/png", png.clone())),
+            None => Err(Error::Invalid(format!("no such picture (this stage has {})", shown.pictures.len()))),
+        }
     }
 
     /// Traces the requested line.
@@ -389,6 +417,9 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
         };
         let name = shadows.name();
         write(&format!("frames/{name}.png"), &shown.png)?;
+        for (k, png) in shown.pictures.iter().enumerate() {
+            write(&format!("pictures/{name}-{k}.png"), png)?;
+        }
         // The visibility part of a line is the same for every stage: written once.
         let first = watkins.is_empty();
         let mut decisions = String::new();

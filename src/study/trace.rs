@@ -6,9 +6,9 @@
 use crate::error::{Error, Result};
 use crate::scan::ActiveEdges;
 use crate::scene::Scene;
-use crate::shadow::{Decision, ShadowContext, ShadowMethod, ShadowOptions, ShadowWalker};
+use crate::shadow::{Decision, Picture, ShadowContext, ShadowMethod, ShadowOptions, ShadowStage, ShadowWalker};
 use crate::stats::Counters;
-use crate::view::View;
+use crate::view::{ScreenPolygon, View};
 use crate::visibility::{resolve, Run, ScanlineVisibility, SpanRecord, Visibility};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -100,47 +100,67 @@ pub fn trace_lines(
             view.height
         )));
     }
-    let screen = view.screen_polygons(scene);
-    let mut counters = Counters::default();
-    let vis = ScanlineVisibility::new(scene, &screen, &view, &mut counters);
-    let edge = |e: (u32, u32, u32, f64, f64, f64)| {
-        let poly = screen[e.0 as usize].poly;
-        EdgeTrace {
-            polygon: poly,
-            face: scene.polygons[poly as usize].face,
-            first_line: e.1,
-            end_line: e.2,
-            top: (e.3, e.4),
-            dxdy: e.5,
-        }
-    };
-    let (mut entering, mut leaving) = (vec![Vec::new(); lines.len()], vec![Vec::new(); lines.len()]);
-    for e in vis.table().edges() {
-        for (at, list) in [(e.1, &mut entering), (e.2, &mut leaving)] {
-            if lines.contains(&at) {
-                list[(at - lines.start) as usize].push(edge(e));
+    with_stage(scene, &view, shadows, options, |screen, vis, ctx, stage| {
+        let edge = |e: (u32, u32, u32, f64, f64, f64)| {
+            let poly = screen[e.0 as usize].poly;
+            EdgeTrace {
+                polygon: poly,
+                face: scene.polygons[poly as usize].face,
+                first_line: e.1,
+                end_line: e.2,
+                top: (e.3, e.4),
+                dxdy: e.5,
+            }
+        };
+        let (mut entering, mut leaving) = (vec![Vec::new(); lines.len()], vec![Vec::new(); lines.len()]);
+        for e in vis.table().edges() {
+            for (at, list) in [(e.1, &mut entering), (e.2, &mut leaving)] {
+                if lines.contains(&at) {
+                    list[(at - lines.start) as usize].push(edge(e));
+                }
             }
         }
-    }
-    let mut visible = Vec::with_capacity(lines.len());
-    vis.walk_recorded(lines.clone(), &mut |_, r, s| visible.push((r.to_vec(), s.to_vec())));
+        let mut visible = Vec::with_capacity(lines.len());
+        vis.walk_recorded(lines.clone(), &mut |_, r, s| visible.push((r.to_vec(), s.to_vec())));
+        let mut walker = stage.walker();
+        for y in 0..lines.start {
+            walker.start_line(y);
+        }
+        let mut aet = ActiveEdges::new(vis.table(), lines.clone());
+        let rows = visible.into_iter().zip(entering).zip(leaving);
+        for (line, (((runs, spans), entering), leaving)) in lines.clone().zip(rows) {
+            walker.start_line(line);
+            let active = aet.advance_to(line).iter().map(|c| (c.x, screen[c.tag as usize].poly)).collect();
+            let decisions = decide(ctx, walker.as_mut(), line, &runs);
+            let shadows = shadows.name().into();
+            emit(LineTrace { line, shadows, entering, leaving, active, spans, runs, decisions })?;
+        }
+        Ok(())
+    })
+}
 
+/// The pictures the shadow stage `shadows` builds for `scene` (Williams: its depth maps).
+pub fn pictures(scene: &Scene, shadows: ShadowMethod, options: &ShadowOptions) -> Result<Vec<Picture>> {
+    let view = View::new(&scene.camera);
+    with_stage(scene, &view, shadows, options, |_, _, _, stage| Ok(stage.pictures()))
+}
+
+/// Prepares what a render prepares before its walk (the screen polygons, Watkins'
+/// visibility, the runs, the shadow stage) and hands it to `f`.
+fn with_stage<T>(
+    scene: &Scene,
+    view: &View,
+    shadows: ShadowMethod,
+    options: &ShadowOptions,
+    f: impl FnOnce(&[ScreenPolygon], &ScanlineVisibility, &ShadowContext, &dyn ShadowStage) -> Result<T>,
+) -> Result<T> {
+    let screen = view.screen_polygons(scene);
+    let mut counters = Counters::default();
+    let vis = ScanlineVisibility::new(scene, &screen, view, &mut counters);
     let frame_runs = resolve(&vis as &dyn Visibility, view.height, &mut counters);
-    let ctx = ShadowContext::new(scene, &view, &frame_runs, options.clone());
+    let ctx = ShadowContext::new(scene, view, &frame_runs, options.clone());
     let stage = shadows.prepare(&ctx, &mut counters)?;
-    let mut walker = stage.walker();
-    for y in 0..lines.start {
-        walker.start_line(y);
-    }
-    let mut aet = ActiveEdges::new(vis.table(), lines.clone());
-    let rows = visible.into_iter().zip(entering).zip(leaving);
-    for (line, (((runs, spans), entering), leaving)) in lines.zip(rows) {
-        walker.start_line(line);
-        let active = aet.advance_to(line).iter().map(|c| (c.x, screen[c.tag as usize].poly)).collect();
-        let decisions = decide(&ctx, walker.as_mut(), line, &runs);
-        emit(LineTrace { line, shadows: shadows.name().into(), entering, leaving, active, spans, runs, decisions })?;
-    }
-    Ok(())
+    f(&screen, &vis, &ctx, stage.as_ref())
 }
 
 /// The shadow stage's decision for every run of `line` and every light sample.

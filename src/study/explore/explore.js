@@ -378,6 +378,7 @@ function drawStage(t) {
   $("stage-title").textContent = `Shadow stage: ${t.shadows}`;
   $("stage-intro").textContent = INTRO[t.shadows] || "";
   const d = pickedDecision(t);
+  $("stage-map-box").hidden = true;
   const c = $("stage-canvas");
   c.height = 30 + 18 * (d ? rowsOf(d.decision.detail) : 1);
   const g = fitCanvas(c);
@@ -425,6 +426,7 @@ function drawStage(t) {
     row++;
   } else if (detail.kind === "texels") {
     drawTexels(g, detail, d, X, row, c.height);
+    showMap(detail, d);
   } else if (detail.kind === "covers") {
     for (const cv of detail.covers) { name(row, `#${cv.polygon}`); bar(cv.start, cv.end, row++, "rgba(250, 200, 40, 0.7)", "lit detail polygon"); }
   }
@@ -488,6 +490,31 @@ function drawTexels(g, detail, d, X, row, height) {
   }
   g.fillStyle = "#4a5160";
   g.fillText("map", x0, y0 + side + 11);
+}
+
+// Williams: the shadow map the run looked up (the face most of its pixels fall in), with the
+// path of its lookups drawn over it.
+function showMap(detail, d) {
+  const pictures = (state.frame && state.frame.pictures) || [];
+  const faces = detail.texels.map((t) => t.face);
+  const face = faces.sort((a, b) => faces.filter((f) => f === b).length - faces.filter((f) => f === a).length)[0] || 0;
+  const index = pictures.findIndex((p) => p.light === d.light && p.sample === d.sample && p.face === face);
+  if (index < 0) return;
+  const src = STATIC ? `pictures/${state.stage}-${index}.png` : `api/picture?${params({ index })}`;
+  const img = $("stage-map");
+  if (img.getAttribute("src") !== src) img.src = src;
+  const c = $("stage-map-path"), g = c.getContext("2d"), size = pictures[index].size;
+  c.width = c.height = 256;
+  g.clearRect(0, 0, 256, 256);
+  g.fillStyle = "rgba(255, 60, 40, 0.9)";
+  for (const t of detail.texels) {
+    if (t.face !== face || !Number.isFinite(t.u) || !Number.isFinite(t.v)) continue;
+    g.fillRect((t.u / size) * 256 - 1, (t.v / size) * 256 - 1, 2, 2);
+  }
+  $("stage-map-caption").textContent =
+    `Light ${d.light} sample ${d.sample}${pictures.length > 1 ? `, cube face ${face}` : ""}: the ${size}² depth map ` +
+    "(nearer is brighter, black where nothing was drawn); red: the texels this run looked up.";
+  $("stage-map-box").hidden = false;
 }
 
 // Rows of the stage canvas: the lit row and the detail's own.
