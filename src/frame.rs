@@ -235,8 +235,8 @@ pub(crate) fn write_png(img: image::DynamicImage, path: &Path) -> Result<()> {
 
 /// The image encoded as PNG, in memory.
 #[cfg(feature = "explore")]
-pub(crate) fn encode_png(img: &image::RgbImage) -> Result<Vec<u8>> {
-    png_bytes(&image::DynamicImage::ImageRgb8(img.clone()), Path::new("(in memory)"))
+pub(crate) fn encode_png(img: image::DynamicImage) -> Result<Vec<u8>> {
+    png_bytes(&img, Path::new("(in memory)"))
 }
 
 fn png_bytes(img: &image::DynamicImage, path: &Path) -> Result<Vec<u8>> {

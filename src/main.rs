@@ -312,7 +312,7 @@ struct ExploreArgs {
     export: Option<PathBuf>,
     /// The exported page's image size, WIDTHxHEIGHT (at most 640x480: every line of every
     /// stage is stored).
-    #[arg(long, default_value = "240x180", value_parser = parse_size)]
+    #[arg(long, default_value = "160x120", value_parser = parse_size)]
     size: (u32, u32),
     /// Write into an --export folder that has files already.
     #[arg(long)]

@@ -202,17 +202,14 @@ impl Explorer {
         };
         let got = render(&scene, &opts(r.shadows))?;
         let reference = render(&scene, &opts(ShadowMethod::RayCast))?;
-        let png = crate::frame::encode_png(&got.frame.color_image(None))?;
+        let png = crate::frame::encode_png(got.frame.color_image(None).into())?;
         let mut summary = summary(&scene, r, &got, &reference);
         // Only the shadow map has pictures; other stages are not prepared a second time.
         let made = match r.shadows {
             ShadowMethod::Williams => super::trace::pictures(&scene, r.shadows, &traced())?,
             _ => Vec::new(),
         };
-        let pictures = made
-            .iter()
-            .map(|p| crate::frame::encode_png(&image::DynamicImage::ImageLuma8(p.image.clone()).to_rgb8()))
-            .collect::<Result<_>>()?;
+        let pictures = made.iter().map(|p| crate::frame::encode_png(p.image.clone().into())).collect::<Result<_>>()?;
         summary["pictures"] = made
             .iter()
             .map(|p| json!({ "light": p.light, "sample": p.sample, "face": p.face, "size": p.size }))
@@ -424,10 +421,18 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
         let first = watkins.is_empty();
         let mut decisions = String::new();
         trace_lines(&explorer.scene_for(&r)?, 0..height, shadows, &traced(), |mut t| {
-            let _ = writeln!(decisions, "umbraDecisions({:?}, {}, {});", name, t.line, to_json(&t.decisions)?);
+            // Bouknight-Kelley's pairs per receiver repeat on every run of the receiver: the
+            // static page leaves them out (the live page shows them).
+            let mut d = serde_json::to_value(&t.decisions).map_err(|e| Error::Internal(e.to_string()))?;
+            for detail in d.as_array_mut().into_iter().flatten().filter_map(|d| d["decision"]["detail"].as_object_mut())
+            {
+                detail.remove("pairs");
+            }
+            let _ = writeln!(decisions, "umbraDecisions({:?}, {}, {});", name, t.line, to_json(&rounded(d))?);
             if first {
                 t.decisions.clear();
-                let _ = writeln!(watkins, "umbraLine({});", to_json(&t)?);
+                let line = serde_json::to_value(&t).map_err(|e| Error::Internal(e.to_string()))?;
+                let _ = writeln!(watkins, "umbraLine({});", to_json(&rounded(line))?);
             }
             Ok(())
         })?;
@@ -443,6 +448,21 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
     write("index.html", PAGE.replace("<!--static-->", r#"<script src="data.js"></script>"#).as_bytes())?;
     write("explore.js", SCRIPT.as_bytes())?;
     write("explore.css", STYLE.as_bytes())
+}
+
+/// Every fractional number in `v` kept to 7 significant digits (what the page shows, and
+/// a third of the bytes of the shortest exact form).
+fn rounded(v: Value) -> Value {
+    match v {
+        Value::Array(a) => Value::Array(a.into_iter().map(rounded).collect()),
+        Value::Object(o) => Value::Object(o.into_iter().map(|(k, v)| (k, rounded(v))).collect()),
+        Value::Number(n) if !n.is_i64() && !n.is_u64() => {
+            let x = n.as_f64().unwrap_or(0.0);
+            let short: f64 = format!("{x:.6e}").parse().unwrap_or(x);
+            serde_json::Number::from_f64(short).map_or(Value::Null, Value::Number)
+        }
+        other => other,
+    }
 }
 
 /// `v` as JSON text, for the exported scripts.

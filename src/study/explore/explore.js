@@ -438,6 +438,9 @@ function drawStage(t) {
 // What the stage found before the walk, in words.
 function extra(d) {
   const detail = d.decision.detail;
+  if (detail.kind === "segments" && !detail.pairs && STATIC) {
+    return "Steps 1-3 (the pairs the prefilter kept for this receiver) are shown by the live page only.";
+  }
   if (detail.kind === "segments" && detail.pairs) {
     const p = detail.pairs;
     const from = p.shadow_polygons.map(([tag, caster]) => `#${tag} from polygon ${caster}`);
