@@ -190,8 +190,17 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
                 let row = ((y - y0) * w) as usize;
                 let t = Instant::now();
                 walker.start_line(y);
-                let tests = tests.as_deref_mut().map(|t| &mut t[row..row + w as usize]);
-                self_shadowed += walk_line(&ctx, walker.as_mut(), y, runs, &mut lit, tests);
+                let mut tests = tests.as_deref_mut().map(|t| &mut t[row..row + w as usize]);
+                self_shadowed += walk_line(&ctx, walker.as_mut(), y, runs, &mut lit, |_, _, _, asked, walker, _| {
+                    // The per-pixel counter image: what the stage tested at each pixel.
+                    if let Some(tests) = tests.as_deref_mut().filter(|_| asked) {
+                        for (x0, x1, n) in walker.decision().tested {
+                            for t in &mut tests[x0 as usize..x1 as usize] {
+                                *t += n;
+                            }
+                        }
+                    }
+                });
                 let t2 = Instant::now();
                 walking += t2 - t;
                 for run in runs {
@@ -246,16 +255,17 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
 
 /// The shadow stage's walk along line `y`: for every run and light sample, the lit fraction
 /// of each pixel into `lit[k * width + x]` (`k` the sample's flat index), 0 where the
-/// sample is behind the run's seen side (the same-side rule, asked before the stage); the
-/// stage's tests per pixel added into `tests` when asked. Returns the runs the same-side
-/// rule settled.
-fn walk_line(
+/// sample is behind the run's seen side (the same-side rule, asked before the stage; it is
+/// applied here and nowhere else). After each run and sample, `after(run, light, sample,
+/// asked, walker, lit)` sees what was decided (`asked`: whether the stage was). Returns the
+/// runs the same-side rule settled.
+pub(crate) fn walk_line(
     ctx: &ShadowContext,
     walker: &mut dyn crate::shadow::ShadowWalker,
     y: u32,
     runs: &[crate::visibility::Run],
     lit: &mut [f32],
-    mut tests: Option<&mut [u32]>,
+    mut after: impl FnMut(&crate::visibility::Run, usize, usize, bool, &dyn crate::shadow::ShadowWalker, &[f32]),
 ) -> u64 {
     let width = ctx.view.width as usize;
     let mut self_shadowed = 0;
@@ -263,19 +273,14 @@ fn walk_line(
         let plane = &ctx.scene.polygons[run.poly as usize].plane;
         for (k, (l, s, sample)) in ctx.all_samples().enumerate() {
             let out = &mut lit[k * width + run.x0 as usize..k * width + run.x1 as usize];
-            if !sample.on_seen_side(plane, ctx.view.eye) {
+            let asked = sample.on_seen_side(plane, ctx.view.eye);
+            if asked {
+                walker.lit(l, s, y, run, out);
+            } else {
                 out.fill(0.0);
                 self_shadowed += 1;
-                continue;
             }
-            walker.lit(l, s, y, run, out);
-            if let Some(tests) = tests.as_deref_mut() {
-                for (x0, x1, n) in walker.decision().tested {
-                    for t in &mut tests[x0 as usize..x1 as usize] {
-                        *t += n;
-                    }
-                }
-            }
+            after(run, l, s, asked, walker, out);
         }
     }
     self_shadowed

@@ -4,7 +4,8 @@
 //!
 //! The same-side rule of section 3 (a polygon whose seen side faces away from a light sample
 //! is in shadow from it — Bouknight and Kelley's self-shadowing test) is applied once by the
-//! pipeline, before any stage is asked; stages only answer for runs the rule leaves lit.
+//! pipeline (`render::walk_line`), before any stage is asked; stages only answer for runs the
+//! rule leaves lit.
 
 pub mod atherton_weiler_greenberg;
 mod bouknight_kelley;

@@ -163,46 +163,29 @@ fn with_stage<T>(
     f(&screen, &vis, &ctx, stage.as_ref())
 }
 
-/// The shadow stage's decision for every run of `line` and every light sample.
+/// The shadow stage's decision for every run of `line` and every light sample, through the
+/// render's own walk.
 fn decide(ctx: &ShadowContext, walker: &mut dyn ShadowWalker, line: u32, runs: &[Run]) -> Vec<ShadowTrace> {
     let mut decisions = Vec::new();
-    let mut lit = vec![0.0f32; ctx.view.width as usize];
-    for run in runs {
-        let plane = &ctx.scene.polygons[run.poly as usize].plane;
-        for (l, s, sample) in ctx.all_samples() {
-            let lit = &mut lit[..(run.x1 - run.x0) as usize];
-            let asked = sample.on_seen_side(plane, ctx.view.eye);
-            let decision = if asked {
-                walker.lit(l, s, line, run, lit);
-                walker.decision()
-            } else {
-                lit.fill(0.0);
-                Decision {
-                    tested: Vec::new(),
-                    note: "the light is behind the seen side: in shadow".into(),
-                    detail: Default::default(),
-                }
-            };
-            let mut pieces: Vec<(u32, u32, f32)> = Vec::new();
-            for (i, &v) in lit.iter().enumerate() {
-                let x = run.x0 + i as u32;
-                match pieces.last_mut() {
-                    Some(p) if p.2 == v && p.1 == x => p.1 = x + 1,
-                    _ => pieces.push((x, x + 1, v)),
-                }
+    let mut lit = vec![0.0f32; ctx.view.width as usize * ctx.all_samples().count()];
+    crate::render::walk_line(ctx, walker, line, runs, &mut lit, |run, l, s, asked, walker, lit| {
+        let decision = if asked {
+            walker.decision()
+        } else {
+            let note = "the light is behind the seen side: in shadow".into();
+            Decision { tested: Vec::new(), note, detail: Default::default() }
+        };
+        let mut pieces: Vec<(u32, u32, f32)> = Vec::new();
+        for (i, &v) in lit.iter().enumerate() {
+            let x = run.x0 + i as u32;
+            match pieces.last_mut() {
+                Some(p) if p.2 == v && p.1 == x => p.1 = x + 1,
+                _ => pieces.push((x, x + 1, v)),
             }
-            decisions.push(ShadowTrace {
-                light: l,
-                sample: s,
-                x0: run.x0,
-                x1: run.x1,
-                polygon: run.poly,
-                lit: pieces,
-                asked_stage: asked,
-                decision,
-            });
         }
-    }
+        let (x0, x1, polygon) = (run.x0, run.x1, run.poly);
+        decisions.push(ShadowTrace { light: l, sample: s, x0, x1, polygon, lit: pieces, asked_stage: asked, decision });
+    });
     decisions
 }
 
