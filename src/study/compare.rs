@@ -391,6 +391,42 @@ mod charts {
     }
 }
 
+/// Each counter across the methods that report it, as bars (one chart a counter, not one
+/// table a method); counters that are zero for every method are named in a line.
+fn counters_html(report: &Report, h: &mut String) {
+    let mut names: Vec<&String> = report.results.iter().flat_map(|r| r.counters.keys()).collect();
+    names.sort();
+    names.dedup();
+    let (mut zero, mut charts) = (Vec::new(), String::new());
+    for name in names {
+        let rows: Vec<(String, u64)> = report
+            .results
+            .iter()
+            .filter_map(|r| r.counters.get(name).map(|&v| (format!("{} + {}", r.visibility, r.shadows), v)))
+            .collect();
+        let most = rows.iter().map(|r| r.1).max().unwrap_or(0);
+        if most == 0 {
+            zero.push(escape(name));
+            continue;
+        }
+        let _ = writeln!(charts, "<h3>{}</h3>\n<table class=\"bars\">", escape(name));
+        for (method, v) in rows {
+            let width = 100.0 * v as f64 / most as f64;
+            let _ = writeln!(
+                charts,
+                "<tr><td class=\"name\">{method}</td><td class=\"bar\"><div style=\"width:{width:.1}%\"></div></td><td>{v}</td></tr>"
+            );
+        }
+        charts.push_str("</table>\n");
+    }
+    h.push_str("<h2 id=\"counters\">Counters</h2>\n<p>Each counter across the methods that count it (bars to scale within a counter).");
+    if !zero.is_empty() {
+        let _ = write!(h, " Zero for every method: {}.", zero.join(", "));
+    }
+    h.push_str("</p>\n");
+    h.push_str(&charts);
+}
+
 fn html(report: &Report) -> String {
     let mut h = String::new();
     let _ = write!(
@@ -398,7 +434,8 @@ fn html(report: &Report) -> String {
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>umbra compare: {scene}</title>\n<style>\n\
          body {{ font-family: sans-serif; margin: 1.5em; }}\ntable {{ border-collapse: collapse; font-size: 0.9em; }}\n\
          th, td {{ border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: right; }}\nth {{ cursor: pointer; background: #eee; }}\n\
-         td.name {{ text-align: left; }}\n.na {{ color: #888; }}\n.noisy {{ color: #b3261e; }}\n.grid {{ display: flex; flex-wrap: wrap; gap: 1em; }}\n\
+         td.name {{ text-align: left; }}\n.na {{ color: #888; }}\n.noisy {{ color: #b3261e; }}\n.bars td {{ border: none; padding: 0.1em 0.5em; }}\n\
+         td.bar {{ width: 360px; }}\ntd.bar div {{ background: #4682b4; height: 0.9em; }}\n.grid {{ display: flex; flex-wrap: wrap; gap: 1em; }}\n\
          figure {{ margin: 0; }}\nfigure img {{ width: 320px; image-rendering: pixelated; }}\nfigcaption {{ font-size: 0.85em; }}\n</style>\n</head>\n<body>\n\
          <h1>umbra compare: {scene}</h1>\n<p>{w}&times;{h} pixels, {n} polygons. Errors are counted at the reference's interior pixels \
          (3&times;3 neighbourhood uniform in face id and lit values); the reference is ray-cast visibility with ray-cast shadows. \
@@ -490,14 +527,8 @@ fn html(report: &Report) -> String {
             r.image, r.time.median_ms, r.diff, r.wrong_pixels
         );
     }
-    h.push_str("</div>\n<h2>Counters</h2>\n");
-    for r in report.results.iter().filter(|r| !r.counters.is_empty()) {
-        let _ = write!(h, "<h3>{} + {}</h3>\n<table>\n", r.visibility, r.shadows);
-        for (k, v) in &r.counters {
-            let _ = writeln!(h, "<tr><td class=\"name\">{}</td><td>{v}</td></tr>", escape(k));
-        }
-        h.push_str("</table>\n");
-    }
+    h.push_str("</div>\n");
+    counters_html(report, &mut h);
     h.push_str(
         "<script>\ndocument.querySelectorAll('#results th').forEach((th, i) => th.addEventListener('click', () => {\n\
          const body = th.closest('table').tBodies[0];\n\
