@@ -155,6 +155,10 @@ fn scale_writes_csv_and_plots() {
         serde_json::from_str(&std::fs::read_to_string(out.join("scale.json")).unwrap()).unwrap();
     assert_eq!(json["points"].as_array().unwrap().len(), 6);
     assert!(json["about"]["options"].as_str().unwrap().starts_with("sweep quads"));
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let doc = scraper::Html::parse_document(&page);
+    assert!(doc.errors.is_empty(), "HTML parse errors: {:?}", doc.errors);
+    assert!(page.contains("src=\"time.svg\"") && page.matches("<tr>").count() == 7);
     assert!(points.iter().all(|p| p.time.min_ms <= p.time.median_ms && p.time.median_ms <= p.time.max_ms));
     for svg in ["time.svg", "counter.svg"] {
         assert!(std::fs::read_to_string(out.join(svg)).unwrap().starts_with("<svg"));

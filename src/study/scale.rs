@@ -134,8 +134,8 @@ pub struct Point {
     pub counter: u64,
 }
 
-/// Runs the sweep, writes `scale.csv` and `scale.json` (the points with what they were
-/// measured with), and with the `plots` feature (on by default)
+/// Runs the sweep, writes `scale.csv`, `scale.json` (the points with what they were
+/// measured with) and `index.html` (a page of both), and with the `plots` feature (on by default)
 /// `time.svg` and `counter.svg`, into `out`.
 pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     std::fs::create_dir_all(&o.out).map_err(|e| Error::Io { path: o.out.clone(), source: e })?;
@@ -207,10 +207,49 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         plot(&o.out.join("time.svg"), o, &points, "frame time (ms)", |p| p.time.median_ms, Some(spread))?;
         plot(&o.out.join("counter.svg"), o, &points, &o.counter, |p| p.counter as f64, None)?;
     }
+    let path = o.out.join("index.html");
+    std::fs::write(&path, page(o, &points, &about)).map_err(|e| Error::Io { path, source: e })?;
     Ok(points)
 }
 
-/// A log-log plot of `y` against the swept value, one line per method.
+/// The sweep as a page: what it was measured with, the plots, and the table.
+fn page(o: &ScaleOptions, points: &[Point], about: &super::About) -> String {
+    let esc = |s: &str| s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+    let mut h = format!(
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>umbra scale: {sweep}</title>\n\
+         <style>body {{ font-family: sans-serif; margin: 1.5em; }} table {{ border-collapse: collapse; }} \
+         td, th {{ border: 1px solid #ccc; padding: 0.2em 0.5em; text-align: right; }} img {{ max-width: 100%; }}</style>\n\
+         </head>\n<body>\n<h1>umbra scale: {sweep} sweep</h1>\n<p>umbra {}, {} UTC; {} ({} cores, {} render threads). {}.</p>\n",
+        about.umbra,
+        about.date_utc,
+        esc(if about.cpu.is_empty() { "CPU not reported" } else { &about.cpu }),
+        about.cores,
+        about.threads,
+        esc(&about.options),
+        sweep = o.sweep.name(),
+    );
+    if cfg!(feature = "plots") {
+        h.push_str(
+            "<p><img src=\"time.svg\" alt=\"frame time\"></p>\n<p><img src=\"counter.svg\" alt=\"counter\"></p>\n",
+        );
+    }
+    let _ = write!(
+        h,
+        "<table>\n<tr><th>{}</th><th>method</th><th>polygons</th><th>median ms</th><th>least</th><th>greatest</th><th>{}</th></tr>\n",
+        o.sweep.parameter(),
+        esc(&o.counter)
+    );
+    for p in points {
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{} + {}</td><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td><td>{}</td></tr>",
+            p.value, p.visibility, p.shadows, p.polygons, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
+        );
+    }
+    h.push_str("</table>\n</body>\n</html>\n");
+    h
+}
+
 #[cfg(feature = "plots")]
 /// What the x axis shows: what was rendered (the polygons of the scene), except on the
 /// sweeps whose parameter is not a polygon count.
