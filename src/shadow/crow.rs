@@ -202,7 +202,7 @@ impl ShadowWalker for Walker<'_> {
                 continue;
             }
             let p = &polys[t as usize];
-            let adds = &mut self.last_adds;
+            let (adds, record) = (&mut self.last_adds, self.stage.ctx.options.keep_outlines);
             // What polygon p adds to the count at pixel x (see `count_at`).
             let counts = |x: u32| {
                 let xc = x as f64 + 0.5;
@@ -213,7 +213,10 @@ impl ShadowWalker for Walker<'_> {
                 if a < z && c != 0 {
                     self.events.push((a, c));
                     self.events.push((z, -c));
-                    adds.push(CountAdd { polygon: t, start: a, end: z, add: c, near_cap: p.near_cap });
+                    // Kept for traces only: a render never asks for them.
+                    if record {
+                        adds.push(CountAdd { polygon: t, start: a, end: z, add: c, near_cap: p.near_cap });
+                    }
                 }
             };
             if first == last {

@@ -13,6 +13,7 @@ use crate::render::{render, RenderOptions};
 use crate::scene::Scene;
 use crate::shadow::{ShadowMethod, ShadowOptions};
 use crate::study::bench::{measure, Spread};
+use crate::study::escape;
 use crate::visibility::VisibilityMethod;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -237,10 +238,6 @@ fn write(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|e| Error::Io { path: path.to_owned(), source: e })
 }
 
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
-
 fn write_files(report: &Report, out: &Path) -> Result<()> {
     let json = serde_json::to_string_pretty(report).map_err(|e| Error::Internal(e.to_string()))?;
     write(&out.join("results.json"), &json)?;
@@ -445,18 +442,7 @@ fn html(report: &Report) -> String {
         h = report.height,
         n = report.polygons
     );
-    let a = &report.about;
-    let _ = writeln!(
-        h,
-        "<p class=\"about\">umbra {}, {} UTC; {} ({} cores, {} render threads, {}). Options: {}.</p>",
-        a.umbra,
-        a.date_utc,
-        escape(if a.cpu.is_empty() { "CPU not reported" } else { &a.cpu }),
-        a.cores,
-        a.threads,
-        escape(&a.os),
-        escape(&a.options)
-    );
+    h.push_str(&report.about.html());
     h.push_str(
         "<h2>Times and errors</h2>\n<p>Click a column to sort. Times are the median (least–greatest) of the \
          timed runs after the warm-up; red where the runs spread over a fifth of the median (a busy machine).</p>\n<table id=\"results\">\n<thead><tr>",

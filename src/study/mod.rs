@@ -53,6 +53,28 @@ impl About {
     }
 }
 
+impl About {
+    /// One HTML paragraph saying what a report was measured with.
+    pub(crate) fn html(&self) -> String {
+        let cpu = if self.cpu.is_empty() { "CPU not reported" } else { &self.cpu };
+        format!(
+            "<p class=\"about\">umbra {}, {} UTC; {} ({} cores, {} render threads, {}). Options: {}.</p>\n",
+            self.umbra,
+            self.date_utc,
+            escape(cpu),
+            self.cores,
+            self.threads,
+            escape(&self.os),
+            escape(&self.options)
+        )
+    }
+}
+
+/// `s` made safe inside HTML text and attributes.
+pub(crate) fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
 /// Seconds since 1970 as a UTC date and time (the civil calendar from a day count, after
 /// Hinnant's `civil_from_days`).
 fn utc(secs: u64) -> String {

@@ -214,18 +214,12 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
 
 /// The sweep as a page: what it was measured with, the plots, and the table.
 fn page(o: &ScaleOptions, points: &[Point], about: &super::About) -> String {
-    let esc = |s: &str| s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
     let mut h = format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>umbra scale: {sweep}</title>\n\
          <style>body {{ font-family: sans-serif; margin: 1.5em; }} table {{ border-collapse: collapse; }} \
          td, th {{ border: 1px solid #ccc; padding: 0.2em 0.5em; text-align: right; }} img {{ max-width: 100%; }}</style>\n\
-         </head>\n<body>\n<h1>umbra scale: {sweep} sweep</h1>\n<p>umbra {}, {} UTC; {} ({} cores, {} render threads). {}.</p>\n",
-        about.umbra,
-        about.date_utc,
-        esc(if about.cpu.is_empty() { "CPU not reported" } else { &about.cpu }),
-        about.cores,
-        about.threads,
-        esc(&about.options),
+         </head>\n<body>\n<h1>umbra scale: {sweep} sweep</h1>\n{}",
+        about.html(),
         sweep = o.sweep.name(),
     );
     if cfg!(feature = "plots") {
@@ -237,7 +231,7 @@ fn page(o: &ScaleOptions, points: &[Point], about: &super::About) -> String {
         h,
         "<table>\n<tr><th>{}</th><th>method</th><th>polygons</th><th>median ms</th><th>least</th><th>greatest</th><th>{}</th></tr>\n",
         o.sweep.parameter(),
-        esc(&o.counter)
+        super::escape(&o.counter)
     );
     for p in points {
         let _ = writeln!(
