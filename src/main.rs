@@ -106,7 +106,7 @@ struct ShadowArgs {
 impl ShadowArgs {
     /// Loads the scene and marks the receivers asked for with `--receiver`.
     fn load(&self, path: &std::path::Path) -> umbra::Result<Scene> {
-        let mut scene = Scene::load(path)?;
+        let mut scene = with_spinner(format!("loading {}", path.display()), || Scene::load(path))?;
         for name in &self.receiver {
             if name == "auto" {
                 if scene.mark_planar_receivers().is_empty() {
@@ -479,9 +479,12 @@ fn run(cli: Cli) -> umbra::Result<()> {
                 umbra::Frame::draw_outlines(&mut img, &out.outlines, [255, 40, 200]);
             }
             write_png(img, &a.output)?;
+            let mut wrote = a.output.display().to_string();
             if let Some(dir) = &a.aov {
                 out.frame.save_aovs(dir)?;
+                wrote += &format!(" and the analysis buffers in {}", dir.display());
             }
+            say(&format!("wrote {wrote}"))?;
             if a.stats {
                 let json = serde_json::to_string(&out.stats).map_err(|e| Error::Internal(e.to_string()))?;
                 stdout(&format!("{json}\n"))?;
@@ -645,6 +648,23 @@ fn refuse_overwrite(paths: &[PathBuf], force: bool) -> umbra::Result<()> {
         Some(p) if !force => Err(Error::Invalid(format!("{}: exists; pass --force to overwrite it", p.display()))),
         _ => Ok(()),
     }
+}
+
+/// Runs `work` with a spinner saying `what` on standard error when it is a terminal (nothing
+/// elsewhere), for work that has no steps to count, such as loading a scene's meshes.
+fn with_spinner<T>(what: String, work: impl FnOnce() -> T) -> T {
+    use std::io::IsTerminal;
+    let spinner = std::io::stderr().is_terminal().then(|| {
+        let spinner = indicatif::ProgressBar::new_spinner();
+        spinner.set_message(what);
+        spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+        spinner
+    });
+    let out = work();
+    if let Some(spinner) = spinner {
+        spinner.finish_and_clear();
+    }
+    out
 }
 
 /// A line about what was done, on standard error (standard output stays for data).

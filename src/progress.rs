@@ -75,6 +75,13 @@ impl Bar {
                 self.bar = Some(bar);
             }
             if let Some(bar) = &self.bar {
+                // Once steps are being done, their rate gives an estimate of what is left.
+                if bar.position() == 0 && self.done > 0 {
+                    let estimate = format!("{}, about {{eta}} left", self.template);
+                    if let Ok(style) = indicatif::ProgressStyle::with_template(&estimate) {
+                        bar.set_style(style);
+                    }
+                }
                 bar.set_position(self.done);
             }
         }

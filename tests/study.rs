@@ -50,9 +50,20 @@ fn compare_reports_every_method_and_a_valid_page() {
         n += 1;
     }
     assert!(n > 20);
-    for chart in ["time-error.svg", "phases.svg"] {
-        assert!(html.contains(&format!("src=\"{chart}\"")), "{chart} is not in the report");
-        assert!(std::fs::read_to_string(out.join(chart)).unwrap().starts_with("<svg"));
+    for chart in ["time-error", "phases"] {
+        assert!(html.contains(&format!("src=\"{chart}.svg\"")), "{chart} is not in the report");
+        assert!(std::fs::read_to_string(out.join(format!("{chart}.svg"))).unwrap().starts_with("<svg"));
+        let png = image::open(out.join(format!("{chart}.png"))).unwrap().to_rgb8();
+        assert!(png.width() > 800 && png.pixels().any(|p| p.0 != [255; 3]), "{chart}.png is blank");
+    }
+    // Each method links to its page in docs/algorithms, and every link leads to a file.
+    let links = scraper::Selector::parse("td a").unwrap();
+    let targets: Vec<&str> = doc.select(&links).filter_map(|a| a.value().attr("href")).collect();
+    for page in ["scanline.md", "crow.md", "bouknight-kelley.md", "williams.md"] {
+        assert!(targets.iter().any(|t| t.ends_with(page)), "no link to {page}: {targets:?}");
+    }
+    for t in &targets {
+        assert!(out.join(t).exists(), "{t} is linked but missing");
     }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
@@ -160,8 +171,10 @@ fn scale_writes_csv_and_plots() {
     assert!(doc.errors.is_empty(), "HTML parse errors: {:?}", doc.errors);
     assert!(page.contains("src=\"time.svg\"") && page.matches("<tr>").count() == 7);
     assert!(points.iter().all(|p| p.time.min_ms <= p.time.median_ms && p.time.median_ms <= p.time.max_ms));
-    for svg in ["time.svg", "counter.svg"] {
-        assert!(std::fs::read_to_string(out.join(svg)).unwrap().starts_with("<svg"));
+    for plot in ["time", "counter"] {
+        assert!(std::fs::read_to_string(out.join(format!("{plot}.svg"))).unwrap().starts_with("<svg"));
+        let png = image::open(out.join(format!("{plot}.png"))).unwrap().to_rgb8();
+        assert_eq!(png.dimensions(), (860, 480));
     }
 }
 

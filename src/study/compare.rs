@@ -263,15 +263,18 @@ fn write_files(report: &Report, out: &Path) -> Result<()> {
     write(&out.join("results.csv"), &csv)?;
     #[cfg(feature = "plots")]
     charts::draw(report, out)?;
-    write(&out.join("report.html"), &html(report))
+    write(&out.join("report.html"), &html(report, out))
 }
 
-/// The report's two charts, in SVG: frame time against wrong pixels for every method, and
-/// each method's frame split into its phases.
+/// The report's two charts, in SVG and PNG: frame time against wrong pixels for every method,
+/// and each method's frame split into its phases.
 #[cfg(feature = "plots")]
 mod charts {
-    use super::Report;
-    use crate::error::{Error, Result};
+    use super::{MethodResult, Report};
+    use crate::error::Result;
+    use crate::study::plot::{log_ticks, save, Chart, ErrText};
+    use plotters::coord::combinators::BindKeyPoints;
+    use plotters::coord::Shift;
     use plotters::prelude::*;
     use std::path::Path;
 
@@ -280,111 +283,112 @@ mod charts {
         ["view", "visibility", "shadow_prepare", "shadow_walk", "shading", "reflections"];
 
     pub(super) fn draw(report: &Report, out: &Path) -> Result<()> {
-        time_against_error(report, &out.join("time-error.svg"))?;
-        phases(report, &out.join("phases.svg"))
-    }
-
-    fn fail(path: &Path) -> impl Fn(String) -> Error + '_ {
-        move |e| Error::Invalid(format!("{}: cannot draw the chart: {e}", path.display()))
+        let ok: Vec<&MethodResult> = report.results.iter().filter(|r| r.status == "ok").collect();
+        save(&TimeAgainstError(&ok), &out.join("time-error"))?;
+        save(&Phases(&ok), &out.join("phases"))
     }
 
     /// Frame time (log) against the share of interior pixels wrong: exact methods lie on
     /// the zero line, the approximate ones above it.
-    fn time_against_error(report: &Report, path: &Path) -> Result<()> {
-        let err = fail(path);
-        let ok: Vec<_> = report.results.iter().filter(|r| r.status == "ok").collect();
-        let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-        let (t0, t1) =
-            ok.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| (a.min(r.time.min_ms), b.max(r.time.max_ms)));
-        let e1 = ok.iter().fold(0.0f64, |m, r| m.max(100.0 * r.error_share)).max(1.0);
-        if ok.is_empty() || t0.is_nan() || t0 <= 0.0 {
-            return root.present().map_err(|e| err(e.to_string()));
+    struct TimeAgainstError<'a>(&'a [&'a MethodResult]);
+
+    impl Chart for TimeAgainstError<'_> {
+        fn size(&self) -> (u32, u32) {
+            (980, 560)
         }
-        let (plot_area, key) = root.split_horizontally(620);
-        let mut chart = ChartBuilder::on(&plot_area)
-            .caption("frame time against error", ("sans-serif", 17))
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d((t0 / 1.3..t1 * 1.3).log_scale(), -0.05 * e1..e1 * 1.15)
-            .map_err(|e| err(e.to_string()))?;
-        chart
-            .configure_mesh()
-            .light_line_style(TRANSPARENT)
-            .bold_line_style(BLACK.mix(0.08))
-            .x_labels(4)
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .x_desc("frame time, ms (median; bar: least to greatest)")
-            .y_desc("interior pixels wrong, %")
-            .draw()
-            .map_err(|e| err(e.to_string()))?;
-        // Each point numbered, the numbers alternating above and below so that neighbours on
-        // the zero line stay legible, and the key beside the plot.
-        let mut by_time = ok.clone();
-        by_time.sort_by(|a, b| a.time.median_ms.total_cmp(&b.time.median_ms));
-        for (i, r) in by_time.iter().enumerate() {
-            let colour = if r.exact { RGBColor(36, 58, 115) } else { RGBColor(200, 60, 40) };
-            let at = (r.time.median_ms, 100.0 * r.error_share);
+
+        fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
+            let ok = self.0;
+            let (t0, t1) =
+                ok.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| (a.min(r.time.min_ms), b.max(r.time.max_ms)));
+            let e1 = ok.iter().fold(0.0f64, |m, r| m.max(100.0 * r.error_share)).max(1.0);
+            if ok.is_empty() || t0.is_nan() || t0 <= 0.0 {
+                return Ok(());
+            }
+            let (plot_area, key) = root.split_horizontally(620);
+            let times = (t0 / 1.3..t1 * 1.3).log_scale().with_key_points(log_ticks(t0 / 1.3, t1 * 1.3));
+            let mut chart = ChartBuilder::on(&plot_area)
+                .caption("frame time against error", ("sans-serif", 17))
+                .margin(16)
+                .x_label_area_size(44)
+                .y_label_area_size(64)
+                .build_cartesian_2d(times, -0.05 * e1..e1 * 1.15)
+                .err_text()?;
             chart
-                .draw_series([PathElement::new(
-                    vec![(r.time.min_ms, at.1), (r.time.max_ms, at.1)],
-                    colour.stroke_width(1),
-                )])
-                .map_err(|e| err(e.to_string()))?;
-            chart.draw_series([Circle::new(at, 4, colour.filled())]).map_err(|e| err(e.to_string()))?;
-            let dy = if i % 2 == 0 { -18 } else { 7 };
-            chart
-                .draw_series([
-                    EmptyElement::at(at) + Text::new(format!("{}", i + 1), (-3, dy), ("sans-serif", 11).into_font())
-                ])
-                .map_err(|e| err(e.to_string()))?;
-            let line = format!("{:>2}. {} + {}: {:.1} ms, {:.3}%", i + 1, r.visibility, r.shadows, at.0, at.1);
-            key.draw(&Text::new(line, (4, 24 + 18 * i as i32), ("sans-serif", 11).into_font().color(&colour)))
-                .map_err(|e| err(e.to_string()))?;
+                .configure_mesh()
+                .light_line_style(TRANSPARENT)
+                .bold_line_style(BLACK.mix(0.08))
+                .x_labels(12)
+                .x_label_formatter(&|v| format!("{v}"))
+                .x_desc("frame time, ms (median; bar: least to greatest)")
+                .y_desc("interior pixels wrong, %")
+                .draw()
+                .err_text()?;
+            // Each point numbered, the numbers alternating above and below so that neighbours
+            // on the zero line stay legible, and the key beside the plot.
+            let mut by_time = ok.to_vec();
+            by_time.sort_by(|a, b| a.time.median_ms.total_cmp(&b.time.median_ms));
+            for (i, r) in by_time.iter().enumerate() {
+                let colour = if r.exact { RGBColor(36, 58, 115) } else { RGBColor(200, 60, 40) };
+                let at = (r.time.median_ms, 100.0 * r.error_share);
+                let bar = vec![(r.time.min_ms, at.1), (r.time.max_ms, at.1)];
+                chart.draw_series([PathElement::new(bar, colour.stroke_width(1))]).err_text()?;
+                chart.draw_series([Circle::new(at, 4, colour.filled())]).err_text()?;
+                let dy = if i % 2 == 0 { -18 } else { 7 };
+                let number = Text::new(format!("{}", i + 1), (-3, dy), ("sans-serif", 11).into_font());
+                chart.draw_series([EmptyElement::at(at) + number]).err_text()?;
+                let line = format!("{:>2}. {} + {}: {:.1} ms, {:.3}%", i + 1, r.visibility, r.shadows, at.0, at.1);
+                let font = ("sans-serif", 11).into_font().color(&colour);
+                key.draw(&Text::new(line, (4, 24 + 18 * i as i32), font)).err_text()?;
+            }
+            Ok(())
         }
-        root.present().map_err(|e| err(e.to_string()))
     }
 
     /// Each method's median frame split into its phases, as stacked horizontal bars.
-    fn phases(report: &Report, path: &Path) -> Result<()> {
-        let err = fail(path);
-        let ok: Vec<_> = report.results.iter().filter(|r| r.status == "ok").collect();
-        let height = 60 + 22 * ok.len() as u32;
-        let root = SVGBackend::new(path, (860, height.max(120))).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-        let total = |r: &&super::MethodResult| PHASES.iter().filter_map(|p| r.step_ms.get(*p)).sum::<f64>();
-        let longest = ok.iter().map(total).fold(0.0f64, f64::max).max(1e-3);
-        let (left, right, top) = (230.0, 600.0, 40);
-        let colours = [
-            RGBColor(150, 150, 150),
-            RGBColor(70, 130, 180),
-            RGBColor(200, 60, 40),
-            RGBColor(240, 160, 40),
-            RGBColor(60, 160, 90),
-            RGBColor(140, 90, 170),
-        ];
-        let text = |s: String, x: i32, y: i32| Text::new(s, (x, y), ("sans-serif", 12));
-        root.draw(&text("median time per phase, ms".into(), 10, 12)).map_err(|e| err(e.to_string()))?;
-        for (k, (p, c)) in PHASES.iter().zip(colours).enumerate() {
-            let x = 260 + 95 * k as i32;
-            root.draw(&Rectangle::new([(x, 8), (x + 10, 18)], c.filled())).map_err(|e| err(e.to_string()))?;
-            root.draw(&text(p.replace('_', " "), x + 14, 8)).map_err(|e| err(e.to_string()))?;
+    struct Phases<'a>(&'a [&'a MethodResult]);
+
+    const COLOURS: [RGBColor; 6] = [
+        RGBColor(150, 150, 150),
+        RGBColor(70, 130, 180),
+        RGBColor(200, 60, 40),
+        RGBColor(240, 160, 40),
+        RGBColor(60, 160, 90),
+        RGBColor(140, 90, 170),
+    ];
+
+    fn total(r: &MethodResult) -> f64 {
+        PHASES.iter().filter_map(|p| r.step_ms.get(*p)).sum()
+    }
+
+    impl Chart for Phases<'_> {
+        fn size(&self) -> (u32, u32) {
+            (860, (60 + 22 * self.0.len() as u32).max(120))
         }
-        for (i, r) in ok.iter().enumerate() {
-            let y = top + 22 * i as i32;
-            root.draw(&text(format!("{} + {}", r.visibility, r.shadows), 10, y + 3)).map_err(|e| err(e.to_string()))?;
-            let mut x = left;
-            for (p, c) in PHASES.iter().zip(colours) {
-                let ms = r.step_ms.get(*p).copied().unwrap_or(0.0);
-                let w = ms / longest * right;
-                root.draw(&Rectangle::new([(x as i32, y), ((x + w) as i32, y + 16)], c.filled()))
-                    .map_err(|e| err(e.to_string()))?;
-                x += w;
+
+        fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
+            let longest = self.0.iter().map(|r| total(r)).fold(0.0f64, f64::max).max(1e-3);
+            let (left, right, top) = (230.0, 560.0, 40);
+            let text = |s: String, x: i32, y: i32| Text::new(s, (x, y), ("sans-serif", 12));
+            root.draw(&text("median time per phase, ms".into(), 10, 12)).err_text()?;
+            for (k, (p, c)) in PHASES.iter().zip(COLOURS).enumerate() {
+                let x = 260 + 95 * k as i32;
+                root.draw(&Rectangle::new([(x, 8), (x + 10, 18)], c.filled())).err_text()?;
+                root.draw(&text(p.replace('_', " "), x + 14, 8)).err_text()?;
             }
-            root.draw(&text(format!("{:.1}", total(r)), x as i32 + 6, y + 3)).map_err(|e| err(e.to_string()))?;
+            for (i, r) in self.0.iter().enumerate() {
+                let y = top + 22 * i as i32;
+                root.draw(&text(format!("{} + {}", r.visibility, r.shadows), 10, y + 3)).err_text()?;
+                let mut x = left;
+                for (p, c) in PHASES.iter().zip(COLOURS) {
+                    let w = r.step_ms.get(*p).copied().unwrap_or(0.0) / longest * right;
+                    root.draw(&Rectangle::new([(x as i32, y), ((x + w) as i32, y + 16)], c.filled())).err_text()?;
+                    x += w;
+                }
+                root.draw(&text(format!("{:.1}", total(r)), x as i32 + 6, y + 3)).err_text()?;
+            }
+            Ok(())
         }
-        root.present().map_err(|e| err(e.to_string()))
     }
 }
 
@@ -424,7 +428,7 @@ fn counters_html(report: &Report, h: &mut String) {
     h.push_str(&charts);
 }
 
-fn html(report: &Report) -> String {
+fn html(report: &Report, out: &Path) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
@@ -475,8 +479,8 @@ fn html(report: &Report) -> String {
         let _ = writeln!(
             h,
             "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td{noisy}>{:.1} ({:.1}–{:.1})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td></tr>",
-            r.visibility,
-            r.shadows,
+            super::method_link(&r.visibility, out),
+            super::method_link(&r.shadows, out),
             escape(&r.status),
             if r.exact { "yes" } else { "no" },
             r.time.median_ms,
@@ -495,8 +499,9 @@ fn html(report: &Report) -> String {
     if cfg!(feature = "plots") {
         h.push_str(
             "<h2>Time against error</h2>\n<p>Exact methods (blue) lie on the zero line; bars span the least to \
-             the greatest run.</p>\n<img src=\"time-error.svg\" alt=\"frame time against wrong pixels\">\n\
-             <h2>Where the time goes</h2>\n<img src=\"phases.svg\" alt=\"time per phase\">\n",
+             the greatest run.</p>\n<img src=\"time-error.svg\" alt=\"frame time against wrong pixels\"> \
+             <a href=\"time-error.png\">PNG</a>\n<h2>Where the time goes</h2>\n<img src=\"phases.svg\" alt=\"time per phase\"> \
+             <a href=\"phases.png\">PNG</a>\n",
         );
     }
     h.push_str("<h2>Images</h2>\n<div class=\"grid\">\n");

@@ -9,6 +9,8 @@ pub mod compare;
 #[cfg(feature = "explore")]
 pub mod explore;
 pub mod false_colour;
+#[cfg(feature = "plots")]
+mod plot;
 pub mod scale;
 pub mod trace;
 
@@ -70,6 +72,27 @@ impl About {
     }
 }
 
+/// A method's name as HTML, linked to its page in the project's `docs/algorithms/` (the
+/// checkout this program was built from) by a path relative to the report in `dir`; the
+/// bare name where that page is not on this machine, or the method has none.
+pub(crate) fn method_link(name: &str, dir: &std::path::Path) -> String {
+    let page = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/algorithms").join(format!("{name}.md"));
+    let href = page.canonicalize().ok().zip(dir.canonicalize().ok()).map(|(page, dir)| relative(&page, &dir));
+    match href {
+        Some(href) => format!("<a href=\"{}\">{}</a>", escape(&href), escape(name)),
+        None => escape(name),
+    }
+}
+
+/// `to` as a path relative to the directory `from` (both absolute), with `/` separators.
+fn relative(to: &std::path::Path, from: &std::path::Path) -> String {
+    let (to, from): (Vec<_>, Vec<_>) = (to.components().collect(), from.components().collect());
+    let common = to.iter().zip(&from).take_while(|(a, b)| a == b).count();
+    let up = std::iter::repeat_n("..".to_string(), from.len() - common);
+    let down = to[common..].iter().map(|c| c.as_os_str().to_string_lossy().into_owned());
+    up.chain(down).collect::<Vec<_>>().join("/")
+}
+
 /// `s` made safe inside HTML text and attributes.
 pub(crate) fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
@@ -93,6 +116,25 @@ fn utc(secs: u64) -> String {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_paths_climb_to_the_common_folder() {
+        use std::path::Path;
+        assert_eq!(
+            relative(Path::new("/r/docs/algorithms/crow.md"), Path::new("/r/docs/compare/s1")),
+            "../../algorithms/crow.md"
+        );
+        assert_eq!(relative(Path::new("/r/docs/x.md"), Path::new("/r/docs")), "x.md");
+    }
+
+    #[test]
+    fn method_links_point_at_pages_that_exist() {
+        let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/compare");
+        assert_eq!(method_link("crow", &here), "<a href=\"../algorithms/crow.md\">crow</a>");
+        assert_eq!(method_link("none", &here), "none");
+    }
+
     #[test]
     fn utc_dates_are_the_calendar_s() {
         assert_eq!(super::utc(0), "1970-01-01 00:00:00");

@@ -2,8 +2,10 @@
 //! comparison of two hidden surface techniques: the scan-line and z-buffer algorithms"
 //! (Computer Graphics Forum 1992): a generated scene family is swept over polygon count,
 //! depth complexity, polygon size, distribution or resolution; every method asked for is
-//! timed (median of runs) with its counters; the results go to a CSV file and SVG plots.
+//! timed (median of runs) with its counters; the results go to a CSV file, a JSON file, plots (SVG and PNG) and a page.
 
+#[cfg(feature = "plots")]
+use super::plot::{log_ticks, ErrText};
 use crate::error::{Error, Result};
 use crate::generate;
 use crate::render::RenderOptions;
@@ -12,10 +14,12 @@ use crate::shadow::{ShadowMethod, ShadowOptions};
 use crate::study::bench::{measure, Spread};
 use crate::visibility::VisibilityMethod;
 #[cfg(feature = "plots")]
+use plotters::coord::combinators::{BindKeyPoints, LogCoord, WithKeyPoints};
+#[cfg(feature = "plots")]
+use plotters::coord::{ranged1d::ValueFormatter, Shift};
+#[cfg(feature = "plots")]
 use plotters::prelude::*;
 use std::fmt::Write as _;
-#[cfg(feature = "plots")]
-use std::path::Path;
 use std::path::PathBuf;
 
 /// What is swept.
@@ -184,7 +188,14 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         let _ = writeln!(
             csv,
             "{},{},{},{},{:.3},{:.3},{:.3},{}",
-            p.value, p.visibility, p.shadows, p.polygons, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
+            p.value,
+            super::method_link(&p.visibility, &o.out),
+            super::method_link(&p.shadows, &o.out),
+            p.polygons,
+            p.time.median_ms,
+            p.time.min_ms,
+            p.time.max_ms,
+            p.counter
         );
     }
     let about = super::About::now(format!(
@@ -204,8 +215,16 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     #[cfg(feature = "plots")]
     {
         let spread: Bounds = |p| (p.time.min_ms, p.time.max_ms);
-        plot(&o.out.join("time.svg"), o, &points, "frame time (ms)", |p| p.time.median_ms, Some(spread))?;
-        plot(&o.out.join("counter.svg"), o, &points, &o.counter, |p| p.counter as f64, None)?;
+        let time = Plot {
+            o,
+            points: &points,
+            label: "frame time (ms)",
+            y: |p: &Point| p.time.median_ms,
+            spread: Some(spread),
+        };
+        super::plot::save(&time, &o.out.join("time"))?;
+        let counter = Plot { o, points: &points, label: &o.counter, y: |p: &Point| p.counter as f64, spread: None };
+        super::plot::save(&counter, &o.out.join("counter"))?;
     }
     let path = o.out.join("index.html");
     std::fs::write(&path, page(o, &points, &about)).map_err(|e| Error::Io { path, source: e })?;
@@ -224,7 +243,8 @@ fn page(o: &ScaleOptions, points: &[Point], about: &super::About) -> String {
     );
     if cfg!(feature = "plots") {
         h.push_str(
-            "<p><img src=\"time.svg\" alt=\"frame time\"></p>\n<p><img src=\"counter.svg\" alt=\"counter\"></p>\n",
+            "<p><img src=\"time.svg\" alt=\"frame time\"> <a href=\"time.png\">PNG</a></p>\n\
+             <p><img src=\"counter.svg\" alt=\"counter\"> <a href=\"counter.png\">PNG</a></p>\n",
         );
     }
     let _ = write!(
@@ -237,7 +257,14 @@ fn page(o: &ScaleOptions, points: &[Point], about: &super::About) -> String {
         let _ = writeln!(
             h,
             "<tr><td>{}</td><td>{} + {}</td><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td><td>{}</td></tr>",
-            p.value, p.visibility, p.shadows, p.polygons, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
+            p.value,
+            super::method_link(&p.visibility, &o.out),
+            super::method_link(&p.shadows, &o.out),
+            p.polygons,
+            p.time.median_ms,
+            p.time.min_ms,
+            p.time.max_ms,
+            p.counter
         );
     }
     h.push_str("</table>\n</body>\n</html>\n");
@@ -279,83 +306,114 @@ fn trim(v: f64) -> String {
 }
 
 #[cfg(feature = "plots")]
-/// One plot: `y` of every method against what was rendered, on log axes, with the spread as
+/// One plot: `y` of every method against what was rendered, on log axes (linear when the
+/// values span less than a decade, where a log axis would show no tick), with the spread as
 /// error bars when `spread` gives it, and the legend beside the plot. A quantity that is zero
 /// everywhere gets a note instead of an empty plot.
-fn plot(
-    path: &Path,
-    o: &ScaleOptions,
-    points: &[Point],
-    label: &str,
-    y: impl Fn(&Point) -> f64,
+struct Plot<'a, Y> {
+    o: &'a ScaleOptions,
+    points: &'a [Point],
+    label: &'a str,
+    y: Y,
     spread: Option<Bounds>,
-) -> Result<()> {
-    let err = |e: String| Error::Invalid(format!("{}: cannot draw the plot: {e}", path.display()));
-    let (x_label, x) = x_axis(o);
-    let root = SVGBackend::new(path, (860, 480)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-    let positive: Vec<&Point> = points.iter().filter(|p| y(p) > 0.0 && x(p) > 0.0).collect();
-    if positive.is_empty() {
-        let note = format!("{label} is zero for every method and every {}: nothing to plot", o.sweep.parameter());
-        root.draw(&Text::new(note, (40, 230), ("sans-serif", 18))).map_err(|e| err(e.to_string()))?;
-        return root.present().map_err(|e| err(e.to_string()));
+}
+
+#[cfg(feature = "plots")]
+impl<Y: Fn(&Point) -> f64> super::plot::Chart for Plot<'_, Y> {
+    fn size(&self) -> (u32, u32) {
+        (860, 480)
     }
-    let low = |v: f64, w: f64| v.min(w);
-    let (x0, x1) = positive.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (low(a, x(p)), b.max(x(p))));
-    let range = |p: &Point| spread.map_or((y(p), y(p)), |f| f(p));
-    let (y0, y1) = positive.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
-        let (lo, hi) = range(p);
-        (low(a, lo.max(f64::MIN_POSITIVE)), b.max(hi))
-    });
-    let (plot_area, legend_area) = root.split_horizontally(640);
-    let mut chart = ChartBuilder::on(&plot_area)
-        .caption(format!("{label} against {x_label} ({} sweep)", o.sweep.name()), ("sans-serif", 17))
-        .margin(14)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d((x0 / 1.3..x1 * 1.3).log_scale(), (y0 / 1.3..y1 * 1.3).log_scale())
-        .map_err(|e| err(e.to_string()))?;
-    chart
-        .configure_mesh()
-        .light_line_style(TRANSPARENT)
-        .bold_line_style(BLACK.mix(0.08))
-        .x_labels(6)
-        .y_labels(6)
-        .x_label_formatter(&|v| tick(*v))
-        .y_label_formatter(&|v| tick(*v))
-        .x_desc(x_label)
-        .y_desc(label)
-        .draw()
-        .map_err(|e| err(e.to_string()))?;
-    for (i, &(v, s)) in o.methods.iter().enumerate() {
-        let colour = Palette99::pick(i).to_rgba();
-        let mine: Vec<&Point> =
-            positive.iter().copied().filter(|p| p.visibility == v.name() && p.shadows == s.name()).collect();
-        let series: Vec<(f64, f64)> = mine.iter().map(|p| (x(p), y(p))).collect();
-        chart.draw_series(LineSeries::new(series.clone(), colour.stroke_width(2))).map_err(|e| err(e.to_string()))?;
-        chart
-            .draw_series(series.into_iter().map(|p| Circle::new(p, 3, colour.filled())))
-            .map_err(|e| err(e.to_string()))?;
-        if spread.is_some() {
-            let bars = mine.iter().map(|p| {
-                let (lo, hi) = range(p);
-                PathElement::new(vec![(x(p), lo.max(y0)), (x(p), hi)], colour.stroke_width(1))
-            });
-            chart.draw_series(bars).map_err(|e| err(e.to_string()))?;
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
+        let Plot { o, points, label, spread, .. } = *self;
+        let y = &self.y;
+        let (x_label, x) = x_axis(o);
+        let positive: Vec<&Point> = points.iter().filter(|p| y(p) > 0.0 && x(p) > 0.0).collect();
+        if positive.is_empty() {
+            let note = format!("{label} is zero for every method and every {}: nothing to plot", o.sweep.parameter());
+            return root.draw(&Text::new(note, (40, 230), ("sans-serif", 18))).err_text();
         }
-        let row = 40 + 22 * i as i32;
-        legend_area
-            .draw(&PathElement::new(vec![(8, row), (30, row)], colour.stroke_width(2)))
-            .map_err(|e| err(e.to_string()))?;
-        legend_area
-            .draw(&Text::new(format!("{v} + {s}"), (36, row - 7), ("sans-serif", 13)))
-            .map_err(|e| err(e.to_string()))?;
+        let (x0, x1) = positive.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(x(p)), b.max(x(p))));
+        let range = |p: &Point| spread.map_or((y(p), y(p)), |f| f(p));
+        let (y0, y1) = positive.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
+            let (lo, hi) = range(p);
+            (a.min(lo.max(f64::MIN_POSITIVE)), b.max(hi))
+        });
+        let (plot_area, legend_area) = root.split_horizontally(640);
+        let caption = format!("{label} against {x_label} ({} sweep)", o.sweep.name());
+        let mut builder = ChartBuilder::on(&plot_area);
+        builder.caption(caption, ("sans-serif", 17)).margin(14).x_label_area_size(44).y_label_area_size(64);
+        // Log axes where the data span a decade or more; a narrower span reads better linear,
+        // from zero.
+        let xs = (x0 / 1.3..x1 * 1.3).log_scale().with_key_points(log_ticks(x0 / 1.3, x1 * 1.3));
+        if y1 / y0 >= 10.0 {
+            let ys = (y0 / 1.3..y1 * 1.3).log_scale().with_key_points(log_ticks(y0 / 1.3, y1 * 1.3));
+            let mut chart = builder.build_cartesian_2d(xs, ys).err_text()?;
+            self.series(&mut chart, &positive, x_label, y0)?;
+        } else {
+            let mut chart = builder.build_cartesian_2d(xs, 0.0..y1 * 1.15).err_text()?;
+            self.series(&mut chart, &positive, x_label, 0.0)?;
+        }
+        self.legend(&legend_area)
     }
-    if spread.is_some() {
-        let row = 52 + 22 * o.methods.len() as i32;
-        legend_area
-            .draw(&Text::new("bars: least to greatest run", (8, row), ("sans-serif", 12)))
-            .map_err(|e| err(e.to_string()))?;
+}
+
+#[cfg(feature = "plots")]
+impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
+    /// The mesh, and each method's line, points and error bars (clipped below at `floor`).
+    fn series<DB: DrawingBackend, YC>(
+        &self,
+        chart: &mut ChartContext<'_, DB, Cartesian2d<WithKeyPoints<LogCoord<f64>>, YC>>,
+        positive: &[&Point],
+        x_label: &str,
+        floor: f64,
+    ) -> std::result::Result<(), String>
+    where
+        YC: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        let (_, x) = x_axis(self.o);
+        chart
+            .configure_mesh()
+            .light_line_style(TRANSPARENT)
+            .bold_line_style(BLACK.mix(0.08))
+            .x_labels(12)
+            .y_labels(12)
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .x_desc(x_label)
+            .y_desc(self.label)
+            .draw()
+            .err_text()?;
+        for (i, &(v, s)) in self.o.methods.iter().enumerate() {
+            let colour = Palette99::pick(i).to_rgba();
+            let mine: Vec<&Point> =
+                positive.iter().copied().filter(|p| p.visibility == v.name() && p.shadows == s.name()).collect();
+            let series: Vec<(f64, f64)> = mine.iter().map(|p| (x(p), (self.y)(p))).collect();
+            chart.draw_series(LineSeries::new(series.clone(), colour.stroke_width(2))).err_text()?;
+            chart.draw_series(series.into_iter().map(|p| Circle::new(p, 3, colour.filled()))).err_text()?;
+            if let Some(f) = self.spread {
+                let bars = mine.iter().map(|p| {
+                    let (lo, hi) = f(p);
+                    PathElement::new(vec![(x(p), lo.max(floor)), (x(p), hi)], colour.stroke_width(1))
+                });
+                chart.draw_series(bars).err_text()?;
+            }
+        }
+        Ok(())
     }
-    root.present().map_err(|e| err(e.to_string()))
+
+    /// The methods' colours beside the plot.
+    fn legend<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
+        for (i, &(v, s)) in self.o.methods.iter().enumerate() {
+            let colour = Palette99::pick(i).to_rgba();
+            let row = 40 + 22 * i as i32;
+            area.draw(&PathElement::new(vec![(8, row), (30, row)], colour.stroke_width(2))).err_text()?;
+            area.draw(&Text::new(format!("{v} + {s}"), (36, row - 7), ("sans-serif", 13))).err_text()?;
+        }
+        if self.spread.is_some() {
+            let row = 52 + 22 * self.o.methods.len() as i32;
+            area.draw(&Text::new("bars: least to greatest run", (8, row), ("sans-serif", 12))).err_text()?;
+        }
+        Ok(())
+    }
 }
