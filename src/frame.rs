@@ -57,6 +57,23 @@ impl Frame {
         }
     }
 
+    /// A frame of background pixels in the memory of `old` (a frame rendered before), so
+    /// that rendering again writes into pages the process already has.
+    pub(crate) fn recycle(old: Frame, width: u32, height: u32, lights: usize, background: Vec3) -> Frame {
+        let n = width as usize * height as usize;
+        let Frame { mut color, mut id, mut light, .. } = old;
+        color.clear();
+        color.resize(n, background);
+        id.clear();
+        id.resize(n, BACKGROUND);
+        light.resize_with(lights, Vec::new);
+        for l in &mut light {
+            l.clear();
+            l.resize(n, 0.0);
+        }
+        Frame { width, height, color, id, light, light_samples: vec![1; lights], counters: None, mirror_id: None }
+    }
+
     fn save(&self, img: image::DynamicImage, path: &Path) -> Result<()> {
         write_png(img, path)
     }

@@ -40,6 +40,7 @@ pub mod error;
 pub mod frame;
 pub mod generate;
 pub mod geometry;
+mod pool;
 mod progress;
 pub mod reference;
 pub mod reflection;
@@ -55,7 +56,7 @@ pub mod visibility;
 
 pub use error::{Error, FileLoc, Result};
 pub use frame::Frame;
-pub use render::{render, RenderOptions, Rendered};
+pub use render::{render, RenderOptions, Rendered, Renderer};
 pub use scene::Scene;
 pub use shadow::ShadowMethod;
 pub use stats::{Counters, Stats};

@@ -141,7 +141,6 @@ impl ShadowArgs {
                 filter,
                 cull_front: self.cull_front,
                 fit_to_view: !self.no_fit,
-                ..WilliamsOptions::default()
             },
             awg_database: None,
             keep_outlines,

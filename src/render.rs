@@ -103,8 +103,66 @@ fn check_frame_memory(scene: &Scene, opts: &RenderOptions) -> Result<()> {
     crate::budget::check(format_args!("a {w}x{h} frame"), crate::budget::mul(w * h, per_pixel))
 }
 
-/// Renders `scene` with the chosen stages.
+/// Renders frames, keeping the memory each frame used for the next: the frame's colour, id
+/// and lit-fraction buffers, the z-buffer's depth and id buffers and Williams' shadow maps.
+/// A program that renders many frames (an animation, a benchmark, a study) renders them
+/// through one `Renderer`, so that after the first frame the system does not hand out and
+/// zero fresh pages for them each time. [`render()`] is the one-call form.
+///
+/// ```
+/// use umbra::{generate, RenderOptions, Renderer};
+///
+/// let scene = generate::cubes(2, false, 64, 48)?;
+/// let mut renderer = Renderer::new();
+/// for _ in 0..3 {
+///     let out = renderer.render(&scene, &RenderOptions::default())?;
+///     assert_eq!(out.frame.id.len(), 64 * 48);
+/// }
+/// # Ok::<(), umbra::Error>(())
+/// ```
+#[derive(Default)]
+pub struct Renderer {
+    pools: crate::pool::Pools,
+    last: Option<Rendered>,
+}
+
+impl Renderer {
+    /// A renderer that keeps nothing yet.
+    pub fn new() -> Renderer {
+        Renderer::default()
+    }
+
+    /// Renders `scene` with the chosen stages, into the memory of the last frame; the
+    /// result lives until the next call.
+    pub fn render(&mut self, scene: &Scene, opts: &RenderOptions) -> Result<&Rendered> {
+        let spare = self.last.take().map(|r| r.frame);
+        let out = render_with(scene, opts, &self.pools, spare)?;
+        Ok(self.last.insert(out))
+    }
+
+    /// The last frame rendered, to keep.
+    pub fn into_rendered(self) -> Option<Rendered> {
+        self.last
+    }
+
+    /// Bytes of frame-sized buffers kept for the next frame (besides the last frame's).
+    pub fn kept_bytes(&self) -> usize {
+        self.pools.bytes()
+    }
+}
+
+/// Renders `scene` with the chosen stages (a fresh [`Renderer`]'s one frame).
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
+    render_with(scene, opts, &Default::default(), None)
+}
+
+/// The frame pass, taking frame-sized buffers from `pools` and `spare`.
+fn render_with(
+    scene: &Scene,
+    opts: &RenderOptions,
+    pools: &crate::pool::Pools,
+    spare: Option<Frame>,
+) -> Result<Rendered> {
     let start = Instant::now();
     // The camera is a public field: a program may have changed it since the scene was built.
     scene.camera.validate().map_err(crate::Error::Invalid)?;
@@ -129,7 +187,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
 
     let t = Instant::now();
     bar.phase(format!("visibility ({})", opts.visibility.name()));
-    let visibility = opts.visibility.prepare(scene, &view, &screen, &mut stats.visibility_counters);
+    let visibility = opts.visibility.prepare(scene, &view, &screen, pools, &mut stats.visibility_counters);
     let runs = crate::visibility::resolve(&*visibility, h, &mut stats.visibility_counters);
     let mut pixel_counters = opts.pixel_counters.then(|| {
         let mut splits = vec![0u16; (w * h) as usize];
@@ -145,14 +203,18 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
 
     let t = Instant::now();
     bar.phase(format!("shadow preparation ({})", opts.shadows.name()));
-    let ctx = ShadowContext::new(scene, &view, &runs, opts.shadow_options.clone());
+    let ctx = ShadowContext::new(scene, &view, &runs, opts.shadow_options.clone()).with_pools(pools);
     stats.light_samples = ctx.samples.iter().map(Vec::len).sum();
     let shadows = opts.shadows.prepare(&ctx, &mut stats.shadow_counters)?;
     stats.time_ms.insert("shadow_prepare", ms(t.elapsed()));
 
     let t = Instant::now();
     let shader = Shader::new(scene, &view, &ctx.samples);
-    let mut frame = Frame::new(w, h, scene.lights.len(), scene.render.background);
+    let (lights, background) = (scene.lights.len(), scene.render.background);
+    let mut frame = match spare {
+        Some(old) => Frame::recycle(old, w, h, lights, background),
+        None => Frame::new(w, h, lights, background),
+    };
     frame.light_samples = ctx.samples.iter().map(|s| s.len() as u32).collect();
     let band = band_height(h);
     let chunk = (band * w) as usize;

@@ -155,12 +155,11 @@ fn reused_map_storage_leaves_nothing_behind() {
     let options = RenderOptions { shadows: ShadowMethod::Williams, ..RenderOptions::default() };
     let first = floor_and_box(false, "[[light]]\nkind = \"point\"\nposition = [1.5, 4.5, 1.0]\n");
     let second = floor_and_box(false, POINT);
-    umbra::render(&first, &options).unwrap();
-    assert!(options.shadow_options.williams.map_storage.bytes() >= 2048 * 2048 * 4);
-    let reused = umbra::render(&second, &options).unwrap().frame;
-    let fresh = umbra::render(&second, &RenderOptions { shadows: ShadowMethod::Williams, ..RenderOptions::default() })
-        .unwrap()
-        .frame;
+    let mut renderer = umbra::Renderer::new();
+    renderer.render(&first, &options).unwrap();
+    assert!(renderer.kept_bytes() >= 2048 * 2048 * 4);
+    let reused = renderer.render(&second, &options).unwrap().frame.clone();
+    let fresh = umbra::render(&second, &options).unwrap().frame;
     assert_eq!(reused.light[0], fresh.light[0]);
     assert_eq!(reused.color, fresh.color);
 }

@@ -25,7 +25,7 @@ pub use planar::Planar;
 pub(crate) use ray_cast::blocked;
 pub use ray_cast::RayCastShadows;
 pub use stencil_volume::StencilVolume;
-pub use williams::{MapStorage, ShadowFilter, Williams, WilliamsOptions};
+pub use williams::{ShadowFilter, Williams, WilliamsOptions};
 
 use crate::error::Result;
 use crate::scene::{LightSample, Scene};
@@ -85,6 +85,8 @@ pub struct ShadowContext<'a> {
     pub samples: Vec<Vec<LightSample>>,
     /// The scene's size (diagonal of its bounds), for tolerances.
     pub extent: f64,
+    /// Where frame-sized buffers (shadow maps) come from and go back to.
+    pub(crate) pools: crate::pool::Pools,
 }
 
 impl<'a> ShadowContext<'a> {
@@ -93,7 +95,12 @@ impl<'a> ShadowContext<'a> {
         let samples = scene.lights.iter().map(|l| l.samples()).collect();
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
         let visible = runs.visible(scene.polygons.len());
-        ShadowContext { scene, view, runs, visible, options, samples, extent }
+        ShadowContext { scene, view, runs, visible, options, samples, extent, pools: Default::default() }
+    }
+
+    /// The same context, taking its frame-sized buffers from `pools` (a renderer's).
+    pub(crate) fn with_pools(self, pools: &crate::pool::Pools) -> Self {
+        ShadowContext { pools: pools.clone(), ..self }
     }
 
     /// Every (light, sample) pair, in order: the flat index of sample `s` of light `l` is

@@ -32,7 +32,7 @@ impl<'a> StencilVolume<'a> {
         crate::budget::check(format_args!("stencil-volume: {samples} lit mask(s) of {w}x{h}"), bytes)?;
         let scene = ctx.scene;
         // The depth buffer of the visible surfaces, from the visibility stage's runs.
-        let mut surface = vec![u32::MAX; w * h as usize];
+        let mut surface = ctx.pools.u32.filled(w * h as usize, u32::MAX);
         for (y, runs) in ctx.runs.lines.iter().enumerate() {
             for r in runs {
                 surface[y * w + r.x0 as usize..y * w + r.x1 as usize].fill(r.poly);
@@ -47,7 +47,7 @@ impl<'a> StencilVolume<'a> {
             .all_samples()
             .map(|(_, _, sample)| {
                 let vols = ScreenVolumes::new(ctx, &adjacency, sample, counting, counters);
-                let mut stencil = vec![0i32; w * h as usize];
+                let mut stencil = ctx.pools.i32.filled(w * h as usize, 0);
                 let written: u64 = stencil
                     .par_chunks_mut(w * band as usize)
                     .enumerate()
@@ -75,11 +75,24 @@ impl<'a> StencilVolume<'a> {
                     })
                     .sum();
                 writes += written;
-                stencil.into_iter().map(|c| c <= 0).collect()
+                let mut lit = ctx.pools.masks.take();
+                lit.clear();
+                lit.extend(stencil.iter().map(|&c| c <= 0));
+                ctx.pools.i32.give(stencil);
+                lit
             })
             .collect();
+        ctx.pools.u32.give(surface);
         counters.add("stencil_writes", writes);
         Ok(StencilVolume { ctx, lit })
+    }
+}
+
+impl Drop for StencilVolume<'_> {
+    fn drop(&mut self) {
+        for mask in self.lit.drain(..) {
+            self.ctx.pools.masks.give(mask);
+        }
     }
 }
 

@@ -27,13 +27,13 @@
 use super::{Decision, ShadowContext, ShadowStage, ShadowWalker, Texel};
 use crate::error::{Error, Result};
 use crate::geometry::Plane;
+use crate::pool::Pool;
 use crate::scene::{Camera, LightSample};
 use crate::stats::Counters;
 use crate::view::{DepthPlane, ScreenPolygon, View};
 use crate::visibility::{rasterize, Run};
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
-use std::sync::{Arc, Mutex};
 use wide::f32x4;
 
 /// How the shadow-map comparison is filtered.
@@ -72,8 +72,6 @@ pub struct WilliamsOptions {
     /// sees rather than to the whole scene (what production engines do; cube maps are not
     /// fitted).
     pub fit_to_view: bool,
-    /// Memory for the maps, shared by clones of these options and kept between renders.
-    pub map_storage: MapStorage,
 }
 
 impl Default for WilliamsOptions {
@@ -87,7 +85,6 @@ impl Default for WilliamsOptions {
             filter: ShadowFilter::Pcf(3),
             cull_front: false,
             fit_to_view: true,
-            map_storage: MapStorage::default(),
         }
     }
 }
@@ -123,46 +120,6 @@ impl WilliamsOptions {
             }
         }
         Ok(())
-    }
-}
-
-/// The memory of the depth maps, kept between renders: frames rendered with the same
-/// options (or clones of them) reuse it, as a real-time renderer keeps its shadow-map
-/// textures, instead of having the system hand out and zero fresh pages for every map of
-/// every frame (which, on the benchmark machine, costs more than drawing the map). It holds
-/// as many maps as the largest render used; a new `MapStorage` starts empty. Not an
-/// option: any two compare equal.
-#[derive(Clone, Default)]
-pub struct MapStorage(Arc<Mutex<Vec<Vec<f32>>>>);
-
-impl MapStorage {
-    /// A buffer to draw a map in (empty if none is kept).
-    fn take(&self) -> Vec<f32> {
-        self.0.lock().map(|mut kept| kept.pop().unwrap_or_default()).unwrap_or_default()
-    }
-
-    /// Keeps a map's buffer for the next render.
-    fn give(&self, buffer: Vec<f32>) {
-        if let Ok(mut kept) = self.0.lock() {
-            kept.push(buffer);
-        }
-    }
-
-    /// Bytes kept.
-    pub fn bytes(&self) -> usize {
-        self.0.lock().map_or(0, |kept| kept.iter().map(|b| b.capacity() * 4).sum())
-    }
-}
-
-impl PartialEq for MapStorage {
-    fn eq(&self, _: &Self) -> bool {
-        true
-    }
-}
-
-impl std::fmt::Debug for MapStorage {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "MapStorage({} bytes kept)", self.bytes())
     }
 }
 
@@ -220,8 +177,8 @@ impl Projection {
 
 /// The world points at the first and last pixel centre of every visible run: each run is a
 /// segment of a planar polygon, so these bound every point the camera sees.
-fn visible_points(ctx: &ShadowContext) -> Vec<DVec3> {
-    let mut pts = Vec::new();
+fn visible_points(ctx: &ShadowContext, mut pts: Vec<DVec3>) -> Vec<DVec3> {
+    pts.clear();
     for (y, runs) in ctx.runs.lines.iter().enumerate() {
         let yc = y as f64 + 0.5;
         for r in runs {
@@ -266,8 +223,9 @@ struct DepthMap {
     rows: [DVec4; 3],
     size: u32,
     nearness: Vec<f32>,
-    /// Where the texels' memory goes back to.
-    storage: MapStorage,
+    /// Where the texels' memory goes back to (the renderer's pool: a real-time renderer
+    /// keeps its shadow-map textures between frames too).
+    storage: Pool<f32>,
 }
 
 impl Drop for DepthMap {
@@ -316,8 +274,8 @@ impl DepthMap {
                 })
                 .collect(),
         };
-        let storage = o.map_storage.clone();
-        let nearness = rasterize::<f32>(&screen, size + PAD, size, false, storage.take()).depth;
+        let storage = ctx.pools.f32.clone();
+        let nearness = rasterize::<f32>(&screen, size + PAD, size, None, storage.take()).depth;
         DepthMap { rows: proj.rows(), proj, size, nearness, storage }
     }
 
@@ -620,7 +578,7 @@ impl LightMaps {
         // light, inside the same window (the same strip of an orthographic map, the same cone
         // from a point light), so the fitted map loses nothing and spends its texels on what
         // is seen. Depth still spans the whole scene.
-        let seen = if o.fit_to_view { visible_points(ctx) } else { Vec::new() };
+        let seen = if o.fit_to_view { visible_points(ctx, ctx.pools.points.take()) } else { Vec::new() };
         let covered = if seen.is_empty() { &corners } else { &seen };
         let near = 1e-6 * ctx.extent;
         let pinhole = |eye: DVec3, axis: DVec3, up: DVec3, fov: f64| {
@@ -648,7 +606,7 @@ impl LightMaps {
                 r.normalize()
             }
         };
-        match sample {
+        let maps = match sample {
             LightSample::Directional(d) => {
                 counters.add("maps_ortho", 1);
                 let u = across(d);
@@ -690,7 +648,9 @@ impl LightMaps {
                     LightMaps::Cube(Box::new(faces), s)
                 }
             }
-        }
+        };
+        ctx.pools.points.give(seen);
+        maps
     }
 
     /// Pass 2 along a run (see [`DepthMap::lit_run`]).

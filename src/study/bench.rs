@@ -5,7 +5,7 @@
 //! the pipeline reports, and the process's peak resident memory so far.
 
 use crate::error::{Error, Result};
-use crate::render::{render, RenderOptions, Rendered};
+use crate::render::{RenderOptions, Rendered, Renderer};
 use crate::scene::Scene;
 use crate::shadow::{ShadowMethod, ShadowOptions};
 use crate::visibility::VisibilityMethod;
@@ -80,23 +80,24 @@ pub struct Measured {
 }
 
 /// The measuring core of `bench`, `compare` and `scale`: `warmup` untimed renders, then
-/// `runs` (at least one) timed renders of `scene` in this process.
+/// `runs` (at least one) timed renders of `scene` in this process, all through one
+/// [`Renderer`], so that every frame after the first reuses the memory of the one before
+/// (the times are the algorithms', not the system's page faults).
 pub fn measure(scene: &Scene, opts: &RenderOptions, warmup: usize, runs: usize) -> Result<Measured> {
+    let mut renderer = Renderer::new();
     for _ in 0..warmup {
-        render(scene, opts)?;
+        renderer.render(scene, opts)?;
     }
     let (mut times_ms, mut phases) = (Vec::new(), BTreeMap::<String, Vec<f64>>::new());
-    let mut last = None;
     for _ in 0..runs.max(1) {
         let t = Instant::now();
-        let out = render(scene, opts)?;
+        let out = renderer.render(scene, opts)?;
         times_ms.push(t.elapsed().as_secs_f64() * 1e3);
         for (k, ms) in out.stats.time_ms.iter().filter(|(k, _)| **k != "total") {
             phases.entry(k.to_string()).or_default().push(*ms);
         }
-        last = Some(out);
     }
-    let last = last.ok_or_else(|| Error::Internal("no timed run".into()))?;
+    let last = renderer.into_rendered().ok_or_else(|| Error::Internal("no timed run".into()))?;
     let phases = phases.into_iter().map(|(k, v)| (k, Spread::of(v))).collect();
     Ok(Measured { frame: Spread::of(times_ms.clone()), times_ms, phases, last })
 }

@@ -10,6 +10,7 @@ pub use ray_cast::RayCastVisibility;
 pub use scanline::{ScanlineVisibility, SpanRecord};
 pub use zbuffer::{rasterize, Depth, DepthBuffer, ZBufferVisibility};
 
+use crate::pool::Pools;
 use crate::scene::Scene;
 use crate::stats::Counters;
 use crate::view::{ScreenPolygon, View};
@@ -62,17 +63,19 @@ impl VisibilityMethod {
         }
     }
 
-    /// Prepares the stage for a view of `scene`; `screen` are the scene's screen polygons.
-    pub fn prepare<'a>(
+    /// Prepares the stage for a view of `scene`; `screen` are the scene's screen polygons;
+    /// frame-sized buffers come from `pools`.
+    pub(crate) fn prepare<'a>(
         self,
         scene: &'a Scene,
         view: &'a View,
         screen: &'a [ScreenPolygon],
+        pools: &Pools,
         counters: &mut Counters,
     ) -> Box<dyn Visibility + 'a> {
         match self {
             VisibilityMethod::Scanline => Box::new(ScanlineVisibility::new(scene, screen, view, counters)),
-            VisibilityMethod::ZBuffer => Box::new(ZBufferVisibility::new(screen, view, counters)),
+            VisibilityMethod::ZBuffer => Box::new(ZBufferVisibility::new(screen, view, pools, counters)),
             VisibilityMethod::RayCast => Box::new(RayCastVisibility::new(scene, view)),
         }
     }
@@ -142,7 +145,7 @@ pub fn resolve_frame(scene: &Scene, method: VisibilityMethod) -> (FrameRuns, Cou
     let view = View::new(&scene.camera);
     let screen = view.screen_polygons(scene);
     let mut counters = Counters::default();
-    let vis = method.prepare(scene, &view, &screen, &mut counters);
+    let vis = method.prepare(scene, &view, &screen, &Pools::default(), &mut counters);
     let runs = resolve(&*vis, view.height, &mut counters);
     (runs, counters)
 }

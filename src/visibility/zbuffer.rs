@@ -4,27 +4,37 @@
 //! reaches it. Then its rows are read out as runs, like every visibility stage.
 
 use super::{runs_of_row, Run, Visibility};
+use crate::pool::Pools;
 use crate::scan::{for_each_span, EdgeTable};
 use crate::stats::Counters;
 use crate::view::{ScreenPolygon, View};
 use rayon::prelude::*;
 use std::ops::Range;
 
-/// The prepared z-buffer stage: the filled polygon-index and depth buffers.
+/// The prepared z-buffer stage: the filled polygon-index buffer (the depth buffer goes back
+/// to the renderer's pool once drawn, and the ids when the stage is dropped).
 pub struct ZBufferVisibility {
     width: u32,
     /// Scene polygon index per pixel, `u32::MAX` for none.
     ids: Vec<u32>,
+    pools: Pools,
 }
 
 impl ZBufferVisibility {
-    /// Rasterises every screen polygon into the buffers.
-    pub fn new(screen: &[ScreenPolygon], view: &View, counters: &mut Counters) -> Self {
-        let buffers = rasterize::<f64>(screen, view.width, view.height, true, Vec::new());
+    /// Rasterises every screen polygon into buffers taken from `pools`.
+    pub(crate) fn new(screen: &[ScreenPolygon], view: &View, pools: &Pools, counters: &mut Counters) -> Self {
+        let buffers = rasterize::<f64>(screen, view.width, view.height, Some(pools.u32.take()), pools.f64.take());
         counters.add("depth_tests", buffers.tests);
         counters.add("depth_writes", buffers.writes);
         counters.add("buffer_bytes", (buffers.ids.len() * 4 + buffers.depth.len() * 8) as u64);
-        ZBufferVisibility { width: view.width, ids: buffers.ids }
+        pools.f64.give(buffers.depth);
+        ZBufferVisibility { width: view.width, ids: buffers.ids, pools: pools.clone() }
+    }
+}
+
+impl Drop for ZBufferVisibility {
+    fn drop(&mut self) {
+        self.pools.u32.give(std::mem::take(&mut self.ids));
     }
 }
 
@@ -84,14 +94,14 @@ pub struct DepthBuffer<D> {
 /// Used for visibility (with ids, in f64) and, from the light, for Williams' shadow maps
 /// (depth only, in f32).
 ///
-/// The depth buffer is built in `storage` (any contents; reallocated if too small), so a
-/// caller drawing many frames can hand back the last frame's buffer instead of having fresh
-/// pages zeroed by the system each time.
+/// The depth buffer is built in `storage`, and the polygon ids (when asked for) in `ids`
+/// (any contents; reallocated if too small), so that a caller drawing many frames can hand
+/// back the last frame's buffers instead of having fresh pages zeroed by the system each time.
 pub fn rasterize<D: Depth>(
     screen: &[ScreenPolygon],
     width: u32,
     height: u32,
-    with_ids: bool,
+    ids: Option<Vec<u32>>,
     storage: Vec<D>,
 ) -> DepthBuffer<D> {
     let (w, h) = (width as usize, height);
@@ -107,7 +117,14 @@ pub fn rasterize<D: Depth>(
         .collect();
     // Zeroed allocations cost nothing until written: each band clears its own rows, in
     // parallel and just before drawing them.
-    let mut ids = if with_ids { vec![0u32; w * h as usize] } else { Vec::new() };
+    let reuse = |mut v: Vec<u32>| {
+        if v.capacity() < w * h as usize {
+            v = vec![0; w * h as usize];
+        }
+        v.resize(w * h as usize, 0);
+        v
+    };
+    let mut ids = ids.map_or_else(Vec::new, reuse);
     let mut depth = if storage.capacity() >= w * h as usize { storage } else { vec![D::ZERO; w * h as usize] };
     depth.resize(w * h as usize, D::ZERO);
     let band = crate::render::band_height(h);
