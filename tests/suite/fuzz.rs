@@ -224,9 +224,9 @@ fn mutate(text: &str, edits: &[(u8, usize, u8)]) -> String {
 }
 
 const SEEDS: [&str; 3] = [
-    include_str!("../scenes/cornell.toml"),
-    include_str!("data/robustness/crow_pentagram_even_odd.toml"),
-    include_str!("data/robustness/crow_light_at_cube_vertex.toml"),
+    include_str!("../../scenes/cornell.toml"),
+    include_str!("../data/robustness/crow_pentagram_even_odd.toml"),
+    include_str!("../data/robustness/crow_light_at_cube_vertex.toml"),
 ];
 
 proptest! {
@@ -257,7 +257,7 @@ proptest! {
     /// Mangled OBJ text: an error naming the file, or a mesh.
     #[test]
     fn mangled_obj_files(edits in prop::collection::vec((any::<u8>(), any::<usize>(), any::<u8>()), 1..6)) {
-        let text = mutate(include_str!("data/robustness/closed_box.obj"), &edits);
+        let text = mutate(include_str!("../data/robustness/closed_box.obj"), &edits);
         if let Err(e) = umbra::scene::parse_obj(&text, Path::new("m.obj")) {
             let msg = e.to_string();
             prop_assert!(!msg.contains('\n') && msg.starts_with("m.obj"), "{}", msg);

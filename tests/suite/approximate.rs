@@ -2,7 +2,7 @@
 //! and resolution matches ray-cast except within a few pixels of shadow edges; Blinn's
 //! planar shadows are right on a floor under a single box, and fail where they must.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::path::Path;

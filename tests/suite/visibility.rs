@@ -1,7 +1,7 @@
 //! Scanline and z-buffer visibility agree with the ray-cast reference at every pixel but ties
 //! (see `umbra::reference`), on every example scene and on hundreds of random scenes.
 
-mod common;
+use crate::common;
 
 use common::*;
 use umbra::generate::{random, RandomOptions};

@@ -3,7 +3,7 @@
 //! robustness scenes and hundreds of random scenes; and the exact stages agree with each
 //! other at every pixel but ties.
 
-mod common;
+use crate::common;
 
 use common::*;
 use umbra::generate::{random, RandomOptions};

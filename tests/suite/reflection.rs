@@ -1,7 +1,7 @@
 //! Planar mirrors: both of seed 003's methods see, through the mirror, the face that one
 //! ray-cast bounce sees, at every interior pixel; a mirror seen from behind reflects nothing.
 
-mod common;
+use crate::common;
 
 use common::*;
 use umbra::frame::BACKGROUND;
