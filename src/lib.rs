@@ -17,6 +17,8 @@
 //! - [`shadow`]: the shadow stages behind one trait.
 //! - [`shading`]: the illumination model.
 //! - [`frame`]: the image and its analysis buffers.
+//! - [`render()`] renders one frame; a [`Renderer`] renders many, each in the memory of the
+//!   last (no frame-sized allocation after the first).
 //!
 //! ```
 //! use umbra::{generate, render, RenderOptions, ShadowMethod, VisibilityMethod};
