@@ -428,6 +428,17 @@ fn counters_html(report: &Report, h: &mut String) {
     h.push_str(&charts);
 }
 
+/// What the frame spent outside the table's four phase columns (the view, reflections, the
+/// frame's own setup), so that the row's columns add up to its median frame.
+fn rest(r: &MethodResult) -> String {
+    if r.status != "ok" {
+        return String::new();
+    }
+    let named: f64 =
+        ["visibility", "shadow_prepare", "shadow_walk", "shading"].iter().filter_map(|k| r.step_ms.get(*k)).sum();
+    format!("{:.1}", (r.time.median_ms - named).max(0.0))
+}
+
 fn html(report: &Report, out: &Path) -> String {
     let mut h = String::new();
     let _ = write!(
@@ -449,7 +460,9 @@ fn html(report: &Report, out: &Path) -> String {
     h.push_str(&report.about.html());
     h.push_str(
         "<h2>Times and errors</h2>\n<p>Click a column to sort. Times are the median (least–greatest) of the \
-         timed runs after the warm-up; red where the runs spread over a fifth of the median (a busy machine).</p>\n<table id=\"results\">\n<thead><tr>",
+         timed runs after the warm-up; red where the runs spread over a fifth of the median (a busy machine). \
+         The phase columns are medians of each phase; <em>rest</em> is the frame less the four phases (the view, \
+         reflections, the frame's setup), so that a row adds up to its frame.</p>\n<table id=\"results\">\n<thead><tr>",
     );
     for col in [
         "visibility",
@@ -461,6 +474,7 @@ fn html(report: &Report, out: &Path) -> String {
         "shadow prepare (ms)",
         "shadow walk (ms)",
         "shading (ms)",
+        "rest (ms)",
         "wrong / interior",
         "error",
     ] {
@@ -478,7 +492,7 @@ fn html(report: &Report, out: &Path) -> String {
         };
         let _ = writeln!(
             h,
-            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td{noisy}>{:.1} ({:.1}–{:.1})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td></tr>",
+            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td{noisy}>{:.1} ({:.1}–{:.1})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td></tr>",
             super::method_link(&r.visibility, out),
             super::method_link(&r.shadows, out),
             escape(&r.status),
@@ -490,6 +504,7 @@ fn html(report: &Report, out: &Path) -> String {
             step("shadow_prepare"),
             step("shadow_walk"),
             step("shading"),
+            rest(r),
             r.wrong_pixels,
             r.interior_pixels,
             100.0 * r.error_share
