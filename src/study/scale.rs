@@ -188,14 +188,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         let _ = writeln!(
             csv,
             "{},{},{},{},{:.3},{:.3},{:.3},{}",
-            p.value,
-            super::method_link(&p.visibility, &o.out),
-            super::method_link(&p.shadows, &o.out),
-            p.polygons,
-            p.time.median_ms,
-            p.time.min_ms,
-            p.time.max_ms,
-            p.counter
+            p.value, p.visibility, p.shadows, p.polygons, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
         );
     }
     let about = super::About::now(format!(

@@ -161,7 +161,10 @@ fn scale_writes_csv_and_plots() {
     // complexity, about 160×90 per quad.
     let z: Vec<u64> = points.iter().filter(|p| p.visibility == "zbuffer").map(|p| p.counter).collect();
     assert!(z[2] > 10 * z[0], "{z:?}");
-    assert_eq!(std::fs::read_to_string(out.join("scale.csv")).unwrap().lines().count(), 7);
+    let csv = std::fs::read_to_string(out.join("scale.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 7);
+    // Plain names in the CSV: the page's links stay on the page.
+    assert!(csv.lines().nth(1).unwrap().starts_with("1,scanline,none,"), "{csv}");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("scale.json")).unwrap()).unwrap();
     assert_eq!(json["points"].as_array().unwrap().len(), 6);
