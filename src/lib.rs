@@ -44,6 +44,7 @@ pub mod generate;
 pub mod geometry;
 mod pool;
 mod progress;
+mod raster;
 pub mod reference;
 pub mod reflection;
 pub mod render;

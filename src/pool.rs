@@ -1,4 +1,4 @@
-//! Memory kept between frames. A [`crate::Renderer`] hands these pools down the pipeline; a
+//! Memory kept between frames. A renderer (`Renderer`) hands these pools down the pipeline; a
 //! stage takes a buffer for a frame-sized array (a depth buffer, a face-id buffer, a shadow
 //! map) and gives it back when done, so that the next frame writes into pages the process
 //! already has instead of having the system hand out and zero fresh ones (which, for a

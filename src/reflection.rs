@@ -23,7 +23,6 @@
 use crate::error::Result;
 use crate::frame::{Frame, BACKGROUND};
 use crate::geometry::{clip_polygon, Plane};
-use crate::render::{render, RenderOptions};
 use crate::scene::{Camera, LightKind, Polygon, Scene};
 use glam::{DMat3, DMat4, DVec3};
 
@@ -55,8 +54,8 @@ impl ReflectionMethod {
 }
 
 impl std::str::FromStr for ReflectionMethod {
-    type Err = crate::Error;
-    fn from_str(s: &str) -> crate::Result<Self> {
+    type Err = crate::error::Error;
+    fn from_str(s: &str) -> crate::error::Result<Self> {
         crate::error::parse_named(s, &Self::ALL, Self::name, "reflection method")
     }
 }
@@ -183,17 +182,18 @@ fn reflected_camera(camera: &Camera, m: DMat4) -> Camera {
     }
 }
 
-/// Adds the reflections of every mirror seen from the front to `frame` (rendered from
-/// `scene` with `opts`), and fills `frame.mirror_id`.
+/// Adds the reflections of every mirror seen from the front to `frame` (whose visible runs
+/// are `runs`), and fills `frame.mirror_id`. `mirror_pass` renders what a mirror shows: the
+/// frame pass over the mirrored scene. Returns whether a mirror was seen.
 pub(crate) fn add_reflections(
     scene: &Scene,
-    opts: &RenderOptions,
+    method: ReflectionMethod,
     frame: &mut Frame,
     runs: &crate::visibility::FrameRuns,
-) -> Result<()> {
-    let method = opts.reflection;
+    mut mirror_pass: impl FnMut(&Scene) -> Result<Frame>,
+) -> Result<bool> {
     if method == ReflectionMethod::Off {
-        return Ok(());
+        return Ok(false);
     }
     let eye = scene.camera.eye;
     let mut mirrors: Vec<u32> = runs
@@ -206,12 +206,10 @@ pub(crate) fn add_reflections(
     mirrors.sort_unstable();
     mirrors.dedup();
     if mirrors.is_empty() {
-        return Ok(());
+        return Ok(false);
     }
     let w = frame.width as usize;
     let mut mirror_id = vec![BACKGROUND; frame.id.len()];
-    let inner =
-        RenderOptions { reflection: ReflectionMethod::Off, progress: false, pixel_counters: false, ..opts.clone() };
     for m_poly in mirrors {
         let plane = scene.polygons[m_poly as usize].plane;
         let rho = scene.material(m_poly as usize).mirror;
@@ -224,7 +222,7 @@ pub(crate) fn add_reflections(
                 (s, true)
             }
         };
-        let seen = render(&reflected, &inner)?.frame;
+        let seen = mirror_pass(&reflected)?;
         for (y, line) in runs.lines.iter().enumerate() {
             for r in line.iter().filter(|r| r.poly == m_poly) {
                 for x in r.x0 as usize..r.x1 as usize {
@@ -237,7 +235,7 @@ pub(crate) fn add_reflections(
         }
     }
     frame.mirror_id = Some(mirror_id);
-    Ok(())
+    Ok(true)
 }
 
 /// The reference: for each pixel whose visible polygon is a mirror seen from the front, the

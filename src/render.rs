@@ -7,12 +7,13 @@
 
 use crate::error::Result;
 use crate::frame::{Frame, PixelCounters};
+use crate::reflection::ReflectionMethod;
 use crate::scene::Scene;
 use crate::shading::{RunShading, Shader};
 use crate::shadow::{ShadowContext, ShadowMethod, ShadowOptions};
 use crate::stats::{Counters, Stats};
 use crate::view::View;
-use crate::visibility::VisibilityMethod;
+use crate::visibility::{FrameRuns, VisibilityMethod};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::Mutex;
@@ -59,13 +60,6 @@ pub struct Rendered {
     /// The outlines of the shadow stage's polygons for the first light sample, when
     /// `shadow_options.keep_outlines` asked for them.
     pub outlines: Vec<Vec<glam::DVec2>>,
-}
-
-/// Lines per band: enough bands to keep every core busy, few enough that each band's setup
-/// (the active edges at its first line) stays small.
-pub fn band_height(height: u32) -> u32 {
-    let bands = (rayon::current_num_threads() as u32 * 4).max(1);
-    height.div_ceil(bands).clamp(8, 64)
 }
 
 fn ms(d: Duration) -> f64 {
@@ -156,16 +150,44 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
     render_with(scene, opts, &Default::default(), None)
 }
 
-/// The frame pass, taking frame-sized buffers from `pools` and `spare`.
+/// The frame pass, then the reflection pass over it, taking frame-sized buffers from `pools`
+/// and `spare`.
 fn render_with(
     scene: &Scene,
     opts: &RenderOptions,
     pools: &crate::pool::Pools,
     spare: Option<Frame>,
 ) -> Result<Rendered> {
+    let (mut out, runs) = frame_pass(scene, opts, pools, spare)?;
+    if opts.reflection != ReflectionMethod::Off {
+        let t = Instant::now();
+        // What a mirror shows is a frame of its own, with one level of reflection.
+        let inner =
+            RenderOptions { reflection: ReflectionMethod::Off, progress: false, pixel_counters: false, ..opts.clone() };
+        let mirror_pass = |mirrored: &Scene| {
+            let (mut seen, _) = frame_pass(mirrored, &inner, pools, None)?;
+            saturate(&mut seen.frame.color);
+            Ok(seen.frame)
+        };
+        if crate::reflection::add_reflections(scene, opts.reflection, &mut out.frame, &runs, mirror_pass)? {
+            out.stats.time_ms.insert("reflections", ms(t.elapsed()));
+        }
+    }
+    saturate(&mut out.frame.color);
+    Ok(out)
+}
+
+/// One frame, without reflections: view, visibility, shadow preparation, then the shadow
+/// walk and shading in parallel bands of lines. Returns the frame and its visible runs.
+fn frame_pass(
+    scene: &Scene,
+    opts: &RenderOptions,
+    pools: &crate::pool::Pools,
+    spare: Option<Frame>,
+) -> Result<(Rendered, FrameRuns)> {
     let start = Instant::now();
     // The camera is a public field: a program may have changed it since the scene was built.
-    scene.camera.validate().map_err(crate::Error::Invalid)?;
+    scene.camera.validate().map_err(crate::error::Error::Invalid)?;
     check_frame_memory(scene, opts)?;
     let mut stats = Stats {
         visibility: opts.visibility.name().into(),
@@ -176,8 +198,8 @@ fn render_with(
         ..Stats::default()
     };
     let view = View::new(&scene.camera);
-    let (w, h) = (view.width, view.height);
-    let mut bar = crate::progress::Bar::new(opts.progress, h as u64, "{msg:40} {bar:30} {pos}/{len} lines {elapsed}");
+    let mut bar =
+        crate::progress::Bar::new(opts.progress, view.height as u64, "{msg:40} {bar:30} {pos}/{len} lines {elapsed}");
 
     let t = Instant::now();
     bar.phase("view: clipping and projecting");
@@ -187,18 +209,7 @@ fn render_with(
 
     let t = Instant::now();
     bar.phase(format!("visibility ({})", opts.visibility.name()));
-    let visibility = opts.visibility.prepare(scene, &view, &screen, pools, &mut stats.visibility_counters);
-    let runs = crate::visibility::resolve(&*visibility, h, &mut stats.visibility_counters);
-    let mut pixel_counters = opts.pixel_counters.then(|| {
-        let mut splits = vec![0u16; (w * h) as usize];
-        visibility.span_splits(0..h, &mut splits);
-        PixelCounters {
-            depth_complexity: depth_complexity(&screen, w, h),
-            span_splits: splits.into_iter().map(u32::from).collect(),
-            shadow_tests: vec![0; (w * h) as usize],
-        }
-    });
-    drop(visibility);
+    let (runs, pixel_counters) = visible_runs(scene, opts, &view, &screen, pools, &mut stats.visibility_counters);
     stats.time_ms.insert("visibility", ms(t.elapsed()));
 
     let t = Instant::now();
@@ -209,18 +220,76 @@ fn render_with(
     stats.time_ms.insert("shadow_prepare", ms(t.elapsed()));
 
     let t = Instant::now();
-    let shader = Shader::new(scene, &view, &ctx.samples);
     let (lights, background) = (scene.lights.len(), scene.render.background);
     let mut frame = match spare {
-        Some(old) => Frame::recycle(old, w, h, lights, background),
-        None => Frame::new(w, h, lights, background),
+        Some(old) => Frame::recycle(old, view.width, view.height, lights, background),
+        None => Frame::new(view.width, view.height, lights, background),
     };
     frame.light_samples = ctx.samples.iter().map(|s| s.len() as u32).collect();
-    let band = band_height(h);
+    frame.counters = pixel_counters;
+    bar.phase("shadow walk and shading");
+    let bands = shade_frame(&ctx, &*shadows, &mut frame, &Mutex::new(&mut bar));
+    bar.finish();
+    // The bands ran on several threads: the wall-clock time of the pass is split between
+    // the shadow walk and the shading in the proportion of their summed band times.
+    let pass = ms(t.elapsed());
+    let (walking, shading) = bands.iter().fold((0.0, 0.0), |(a, b), band| (a + ms(band.1), b + ms(band.2)));
+    let walk_share = if walking + shading > 0.0 { walking / (walking + shading) } else { 0.0 };
+    for (shadow, ..) in &bands {
+        stats.shadow_counters.merge(shadow);
+    }
+    stats.time_ms.insert("shadow_walk", pass * walk_share);
+    stats.time_ms.insert("shading", pass * (1.0 - walk_share));
+    stats.time_ms.insert("total", ms(start.elapsed()));
+    let outlines = shadows.outlines();
+    drop(shadows);
+    drop(ctx);
+    Ok((Rendered { frame, stats, outlines }, runs))
+}
+
+/// The visibility stage: every line's visible runs, and the per-pixel counters of the
+/// visible surface when asked for.
+fn visible_runs(
+    scene: &Scene,
+    opts: &RenderOptions,
+    view: &View,
+    screen: &[crate::view::ScreenPolygon],
+    pools: &crate::pool::Pools,
+    counters: &mut Counters,
+) -> (FrameRuns, Option<PixelCounters>) {
+    let (w, h) = (view.width, view.height);
+    let visibility = opts.visibility.prepare(scene, view, screen, pools, counters);
+    let runs = crate::visibility::resolve(&*visibility, h, counters);
+    let pixel_counters = opts.pixel_counters.then(|| {
+        let mut splits = vec![0u16; (w * h) as usize];
+        visibility.span_splits(0..h, &mut splits);
+        PixelCounters {
+            depth_complexity: depth_complexity(screen, w, h),
+            span_splits: splits.into_iter().map(u32::from).collect(),
+            shadow_tests: vec![0; (w * h) as usize],
+        }
+    });
+    (runs, pixel_counters)
+}
+
+/// What one band of lines took: the shadow stage's counters, the time walking, the time
+/// shading.
+type BandWork = (Counters, Duration, Duration);
+
+/// The shadow walk and shading of the whole frame, in parallel bands of lines, each band
+/// writing its own rows of every buffer.
+fn shade_frame(
+    ctx: &ShadowContext,
+    shadows: &dyn crate::shadow::ShadowStage,
+    frame: &mut Frame,
+    progress: &Mutex<&mut crate::progress::Bar>,
+) -> Vec<BandWork> {
+    let shader = Shader::new(ctx.scene, ctx.view, &ctx.samples);
+    let w = frame.width;
+    let band = crate::scan::band_height(frame.height);
     let chunk = (band * w) as usize;
-    // Each band gets its own rows of every buffer.
     let mut light_rows: Vec<_> = frame.light.iter_mut().map(|l| l.chunks_mut(chunk)).collect();
-    let mut test_rows = pixel_counters.as_mut().map(|c| c.shadow_tests.chunks_mut(chunk));
+    let mut test_rows = frame.counters.as_mut().map(|c| c.shadow_tests.chunks_mut(chunk));
     let jobs: Vec<Band> = frame
         .color
         .chunks_mut(chunk)
@@ -234,85 +303,68 @@ fn render_with(
             tests: test_rows.as_mut().and_then(|rows| rows.next()),
         })
         .collect();
-    bar.phase("shadow walk and shading");
-    let progress = Mutex::new(bar);
+    jobs.into_par_iter()
+        .map(|job| {
+            let lines = job.y0..job.y0 + (job.id.len() / w as usize) as u32;
+            let work = shade_band(ctx, shadows, &shader, job);
+            if let Ok(mut p) = progress.lock() {
+                p.advance(lines.len() as u64);
+            }
+            work
+        })
+        .collect()
+}
+
+/// One band, line by line in order: the shadow stage's walk along the line (with the
+/// same-side rule), then the shading of each run from the lit fractions it left.
+fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, shader: &Shader, job: Band) -> BandWork {
+    let Band { y0, color, id, mut light, mut tests } = job;
+    let w = ctx.view.width;
+    let y1 = y0 + (id.len() / w as usize) as u32;
+    let mut shadow = Counters::default();
+    let mut walker = shadows.walker();
+    // Each sample's lit fraction along the line, sample by sample.
     let sample_count: usize = ctx.samples.iter().map(Vec::len).sum();
-    let bands: Vec<(Counters, Duration, Duration)> = jobs
-        .into_par_iter()
-        .map(|out| {
-            let Band { y0, color, id, mut light, mut tests } = out;
-            let y1 = y0 + (id.len() / w as usize) as u32;
-            let mut shadow = Counters::default();
-            let mut walker = shadows.walker();
-            // Each sample's lit fraction along the line, sample by sample.
-            let mut lit = vec![0.0f32; sample_count * w as usize];
-            let mut rs = RunShading::default();
-            let (mut self_shadowed, mut walking, mut shading) = (0u64, Duration::ZERO, Duration::ZERO);
-            for (y, runs) in (y0..y1).zip(&runs.lines[y0 as usize..y1 as usize]) {
-                let row = ((y - y0) * w) as usize;
-                let t = Instant::now();
-                walker.start_line(y);
-                let mut tests = tests.as_deref_mut().map(|t| &mut t[row..row + w as usize]);
-                self_shadowed += walk_line(&ctx, walker.as_mut(), y, runs, &mut lit, |_, _, _, asked, walker, _| {
-                    // The per-pixel counter image: what the stage tested at each pixel.
-                    if let Some(tests) = tests.as_deref_mut().filter(|_| asked) {
-                        for (x0, x1, n) in walker.decision().tested {
-                            for t in &mut tests[x0 as usize..x1 as usize] {
-                                *t += n;
-                            }
-                        }
-                    }
-                });
-                let t2 = Instant::now();
-                walking += t2 - t;
-                for run in runs {
-                    let (a, b) = (row + run.x0 as usize, row + run.x1 as usize);
-                    id[a..b].fill(scene.polygons[run.poly as usize].face);
-                    color[a..b].fill(shader.ambient(run.poly as usize));
-                    shader.begin_run(run, y, &mut rs);
-                    for (k, (l, s, _)) in ctx.all_samples().enumerate() {
-                        let at = k * w as usize;
-                        let lit = &lit[at + run.x0 as usize..at + run.x1 as usize];
-                        let share = 1.0 / ctx.samples[l].len() as f32;
-                        for (f, &v) in light[l][a..b].iter_mut().zip(lit) {
-                            *f += v * share;
-                        }
-                        shader.add_light(&mut rs, l, s, lit, &mut color[a..b]);
+    let mut lit = vec![0.0f32; sample_count * w as usize];
+    let mut rs = RunShading::default();
+    let (mut self_shadowed, mut walking, mut shading) = (0u64, Duration::ZERO, Duration::ZERO);
+    for (y, runs) in (y0..y1).zip(&ctx.runs.lines[y0 as usize..y1 as usize]) {
+        let row = ((y - y0) * w) as usize;
+        let t = Instant::now();
+        walker.start_line(y);
+        let mut tests = tests.as_deref_mut().map(|t| &mut t[row..row + w as usize]);
+        self_shadowed += walk_line(ctx, walker.as_mut(), y, runs, &mut lit, |_, _, _, asked, walker, _| {
+            // The per-pixel counter image: what the stage tested at each pixel.
+            if let Some(tests) = tests.as_deref_mut().filter(|_| asked) {
+                for (x0, x1, n) in walker.decision().tested {
+                    for t in &mut tests[x0 as usize..x1 as usize] {
+                        *t += n;
                     }
                 }
-                shading += t2.elapsed();
             }
-            walker.finish(&mut shadow);
-            shadow.add("self_shadowed_runs", self_shadowed);
-            if let Ok(mut p) = progress.lock() {
-                p.advance((y1 - y0) as u64);
+        });
+        let t2 = Instant::now();
+        walking += t2 - t;
+        for run in runs {
+            let (a, b) = (row + run.x0 as usize, row + run.x1 as usize);
+            id[a..b].fill(ctx.scene.polygons[run.poly as usize].face);
+            color[a..b].fill(shader.ambient(run.poly as usize));
+            shader.begin_run(run, y, &mut rs);
+            for (k, (l, s, _)) in ctx.all_samples().enumerate() {
+                let at = k * w as usize;
+                let lit = &lit[at + run.x0 as usize..at + run.x1 as usize];
+                let share = 1.0 / ctx.samples[l].len() as f32;
+                for (f, &v) in light[l][a..b].iter_mut().zip(lit) {
+                    *f += v * share;
+                }
+                shader.add_light(&mut rs, l, s, lit, &mut color[a..b]);
             }
-            (shadow, walking, shading)
-        })
-        .collect();
-    if let Ok(p) = progress.lock() {
-        p.finish();
+        }
+        shading += t2.elapsed();
     }
-    // The bands ran on several threads: the wall-clock time of the pass is split between
-    // the shadow walk and the shading in the proportion of their summed band times.
-    let pass = ms(t.elapsed());
-    let (walking, shading) = bands.iter().fold((0.0, 0.0), |(a, b), band| (a + ms(band.1), b + ms(band.2)));
-    let walk_share = if walking + shading > 0.0 { walking / (walking + shading) } else { 0.0 };
-    for (shadow, ..) in &bands {
-        stats.shadow_counters.merge(shadow);
-    }
-    stats.time_ms.insert("shadow_walk", pass * walk_share);
-    stats.time_ms.insert("shading", pass * (1.0 - walk_share));
-    stats.time_ms.insert("total", ms(start.elapsed()));
-    frame.counters = pixel_counters;
-    let outlines = shadows.outlines();
-    let t = Instant::now();
-    crate::reflection::add_reflections(scene, opts, &mut frame, &runs)?;
-    if frame.mirror_id.is_some() {
-        stats.time_ms.insert("reflections", ms(t.elapsed()));
-    }
-    saturate(&mut frame.color);
-    Ok(Rendered { frame, stats, outlines })
+    walker.finish(&mut shadow);
+    shadow.add("self_shadowed_runs", self_shadowed);
+    (shadow, walking, shading)
 }
 
 /// The shadow stage's walk along line `y`: for every run and light sample, the lit fraction

@@ -21,6 +21,14 @@
 use glam::DVec2;
 use std::ops::Range;
 
+/// Lines per band, when the lines of a frame are shared among threads in bands: enough bands
+/// to keep every core busy, few enough that each band's setup (the active edges at its first
+/// line) stays small.
+pub fn band_height(height: u32) -> u32 {
+    let bands = (rayon::current_num_threads() as u32 * 4).max(1);
+    height.div_ceil(bands).clamp(8, 64)
+}
+
 /// One non-horizontal edge, stored from its upper vertex.
 #[derive(Debug, Clone, Copy)]
 struct Edge {

@@ -365,8 +365,8 @@ impl ShadowMethod {
 }
 
 impl std::str::FromStr for ShadowMethod {
-    type Err = crate::Error;
-    fn from_str(s: &str) -> crate::Result<Self> {
+    type Err = crate::error::Error;
+    fn from_str(s: &str) -> crate::error::Result<Self> {
         crate::error::parse_named(s, &Self::ALL, Self::name, "shadow method")
     }
 }

@@ -22,7 +22,7 @@ pub struct StencilVolume<'a> {
 
 impl<'a> StencilVolume<'a> {
     /// Rasterises every light sample's shadow polygons into a stencil count.
-    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> crate::Result<Self> {
+    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> crate::error::Result<Self> {
         let view = ctx.view;
         let (w, h) = (view.width as usize, view.height);
         let pixels = w as u64 * h as u64;
@@ -41,7 +41,7 @@ impl<'a> StencilVolume<'a> {
         let planes: Vec<Option<DepthPlane>> = scene.polygons.iter().map(|p| view.depth_plane(&p.plane)).collect();
         let adjacency = Adjacency::new(scene, ctx.options.silhouettes);
         let counting = ctx.options.crow_count;
-        let band = crate::render::band_height(h);
+        let band = crate::scan::band_height(h);
         let mut writes = 0u64;
         let lit = ctx
             .all_samples()

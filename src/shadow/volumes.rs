@@ -79,8 +79,8 @@ impl Counting {
 }
 
 impl std::str::FromStr for Counting {
-    type Err = crate::Error;
-    fn from_str(s: &str) -> crate::Result<Self> {
+    type Err = crate::error::Error;
+    fn from_str(s: &str) -> crate::error::Result<Self> {
         crate::error::parse_named(s, &Self::ALL, Self::name, "count")
     }
 }
@@ -370,7 +370,7 @@ struct KeyedEdge {
 impl Adjacency {
     /// The adjacency of the scene's shadow-casting polygons. Vertices are welded by exact
     /// position. Without `merge`, every polygon keeps its own volume (to measure the saving).
-    pub fn new(scene: &crate::Scene, merge: bool) -> Self {
+    pub fn new(scene: &crate::scene::Scene, merge: bool) -> Self {
         let mut adjacency = Adjacency::default();
         let mut keyed = Vec::new();
         for (p, poly) in scene.polygons.iter().enumerate() {

@@ -3,7 +3,7 @@
 //! (Reeves, Salesin & Cook 1987) and the soft-edged screen-space blur of seed 002.
 //!
 //! **Pass 1** renders the depth of the shadow casters from each light sample with the same
-//! z-buffer loop as visibility ([`crate::visibility::rasterize`]): a perspective map aimed at
+//! z-buffer loop as visibility (`raster::rasterize`): a perspective map aimed at
 //! the scene when the scene lies within 80° of one direction from the sample (spot and point
 //! lights outside the scene, area-light samples), a cube of six 90° maps when it surrounds
 //! the sample, and an orthographic map fitted to the scene for a directional light. The map
@@ -28,10 +28,11 @@ use super::{Decision, ShadowContext, ShadowStage, ShadowWalker, Texel};
 use crate::error::{Error, Result};
 use crate::geometry::Plane;
 use crate::pool::Pool;
+use crate::raster::rasterize;
 use crate::scene::{Camera, LightSample};
 use crate::stats::Counters;
 use crate::view::{DepthPlane, ScreenPolygon, View};
-use crate::visibility::{rasterize, Run};
+use crate::visibility::Run;
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
 use wide::f32x4;

@@ -8,7 +8,6 @@ pub mod bench;
 pub mod compare;
 #[cfg(feature = "explore")]
 pub mod explore;
-pub mod false_colour;
 #[cfg(feature = "plots")]
 mod plot;
 pub mod scale;

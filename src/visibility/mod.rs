@@ -8,7 +8,7 @@ mod zbuffer;
 
 pub use ray_cast::RayCastVisibility;
 pub use scanline::{ScanlineVisibility, SpanRecord};
-pub use zbuffer::{rasterize, Depth, DepthBuffer, ZBufferVisibility};
+pub use zbuffer::ZBufferVisibility;
 
 use crate::pool::Pools;
 use crate::scene::Scene;
@@ -82,8 +82,8 @@ impl VisibilityMethod {
 }
 
 impl std::str::FromStr for VisibilityMethod {
-    type Err = crate::Error;
-    fn from_str(s: &str) -> crate::Result<Self> {
+    type Err = crate::error::Error;
+    fn from_str(s: &str) -> crate::error::Result<Self> {
         crate::error::parse_named(s, &Self::ALL, Self::name, "visibility method")
     }
 }
@@ -120,7 +120,7 @@ impl FrameRuns {
 /// Walks every line of a prepared stage in parallel bands and keeps the runs.
 pub fn resolve(vis: &dyn Visibility, height: u32, counters: &mut Counters) -> FrameRuns {
     use rayon::prelude::*;
-    let band = crate::render::band_height(height);
+    let band = crate::scan::band_height(height);
     let bands: Vec<(Vec<Vec<Run>>, Counters)> = (0..height.div_ceil(band))
         .into_par_iter()
         .map(|b| {
@@ -140,7 +140,7 @@ pub fn resolve(vis: &dyn Visibility, height: u32, counters: &mut Counters) -> Fr
 }
 
 /// Runs one visibility stage alone over a whole frame of `scene`: projects, prepares and
-/// resolves every line, as [`crate::render()`] does (for benchmarks and studies).
+/// resolves every line, as the renderer does (for benchmarks and studies).
 pub fn resolve_frame(scene: &Scene, method: VisibilityMethod) -> (FrameRuns, Counters) {
     let view = View::new(&scene.camera);
     let screen = view.screen_polygons(scene);

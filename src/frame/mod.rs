@@ -1,6 +1,8 @@
 //! The frame: colour, and the analysis buffers of `SCENE_FORMAT.md` section 4 (face id per
 //! pixel, lit fraction per light), with their PNG encodings.
 
+mod false_colour;
+
 use crate::error::{Error, Result};
 use glam::Vec3;
 use std::path::Path;
@@ -193,7 +195,7 @@ impl Frame {
                 ("span_splits", &c.span_splits),
                 ("shadow_tests", &c.shadow_tests),
             ] {
-                let img = crate::study::false_colour::image(values, self.width, self.height);
+                let img = false_colour::image(values, self.width, self.height);
                 self.save(img.into(), &dir.join(format!("{name}.png")))?;
             }
         }
