@@ -10,7 +10,7 @@
 //!       ──shadow──▶ lit value per light sample ──shading──▶ Frame
 //! ```
 //!
-//! - [`scene`]: the scene file of `SCENE_FORMAT.md` (TOML + OBJ), compiled to world polygons.
+//! - [`scene`]: the scene file of `docs/scene-format.md` (TOML + OBJ), compiled to world polygons.
 //! - [`view`]: camera, pixel-centre rule, near/far clipping, projection.
 //! - [`scan`]: the edge table and active edge table every scanline stage walks.
 //! - [`visibility`]: Watkins' scanline algorithm, the z-buffer, and a ray-cast reference.

@@ -84,13 +84,13 @@ struct ShadowArgs {
     #[arg(long)]
     receiver_plane: bool,
     /// Williams: nearest (one texel), pcf (percentage-closer filtering over --pcf-size²
-    /// texels), or soft-edge (seed 002: PCF into a screen buffer, then a 15-tap Gaussian blur).
+    /// texels), or soft-edge (Shastry's "Soft-Edged Shadows": PCF into a screen buffer, then a 15-tap Gaussian blur).
     #[arg(long, value_enum, default_value = "pcf")]
     shadow_filter: FilterArg,
-    /// Williams: the PCF kernel's side in texels (odd; 3 is seed 002's kernel).
+    /// Williams: the PCF kernel's side in texels (odd; 3 is Shastry's kernel).
     #[arg(long, default_value_t = 3)]
     pcf_size: u32,
-    /// Williams: leave polygons facing the light out of the depth map (seed 003).
+    /// Williams: leave polygons facing the light out of the depth map (the "Special Effect" notes).
     #[arg(long)]
     cull_front: bool,
     /// Williams: fit each map to the whole scene, not to the points the camera sees.
@@ -150,7 +150,7 @@ impl ShadowArgs {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// The scene file (TOML, see SCENE_FORMAT.md).
+    /// The scene file (TOML, see docs/scene-format.md).
     scene: PathBuf,
     /// Where to write the image (PNG).
     #[arg(short, long, default_value = "out.png")]
@@ -183,7 +183,7 @@ struct RenderArgs {
     #[arg(long, value_enum)]
     debug: Option<Debug>,
     /// Planar mirrors (materials with mirror > 0): reflect the scene and lights (scene,
-    /// seed 003's method 2), reflect the eye (eye, method 1), or render mirrors plainly (off).
+    /// the "Special Effect" notes' method 2), reflect the eye (eye, method 1), or render mirrors plainly (off).
     #[arg(long, default_value = "scene", value_parser = parse::<ReflectionMethod>)]
     reflection: ReflectionMethod,
 }
@@ -365,7 +365,7 @@ enum FilterArg {
     Nearest,
     /// Percentage-closer filtering.
     Pcf,
-    /// PCF, then seed 002's screen-space blur.
+    /// PCF, then Shastry's screen-space blur.
     SoftEdge,
 }
 

@@ -1,4 +1,4 @@
-//! Planar mirrors (seed 003, "Planar Reflect"): one level of reflection, clipped to the
+//! Planar mirrors (the "Special Effect" notes, "Planar Reflect"): one level of reflection, clipped to the
 //! mirror's visible spans — the scanline equivalent of the stencil step.
 //!
 //! A material with `mirror = ρ` (0 < ρ ≤ 1) makes its polygons mirrors; the front side (the
@@ -60,7 +60,7 @@ impl std::str::FromStr for ReflectionMethod {
     }
 }
 
-/// The reflection through `plane` (`n·x + d = 0`), built as seed 003 derives it:
+/// The reflection through `plane` (`n·x + d = 0`), built as the "Special Effect" notes derive it:
 /// `M = T(p₀) · Rᵀ · S(1, −1, 1) · R · T(−p₀)` with `p₀ = −d n` the plane's point nearest the
 /// origin and `R` the rotation whose rows are `U, N, V` (N onto the y axis, U and V across it).
 /// (The seed writes the plane as `⟨N, P⟩ + d = 0` and the translations as `T(±dN)`; the

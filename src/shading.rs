@@ -1,4 +1,5 @@
-//! Shading: the local illumination model of seeds 001 and 004 and the three shading modes.
+//! Shading: the local illumination model of the "Lighting and Shading" and "Árnyékolás" notes
+//! (docs/sources.md) and the three shading modes.
 //!
 //! Per R, G, B, summed over lights `l` and their samples `s`:
 //!
@@ -21,7 +22,7 @@
 //!
 //! Shading modes, per material:
 //! - **flat**: one colour per polygon and sample, lit at the polygon's centroid with its
-//!   plane normal (seed 001).
+//!   plane normal (the "Lighting and Shading" notes).
 //! - **Gouraud**: colours lit at the vertices (vertex normals from OBJ `vn`, or averaged over
 //!   the faces sharing the vertex), interpolated along the polygon's edges to the scanline and
 //!   along the span between them.

@@ -1,4 +1,4 @@
-//! The view: the camera basis and pixel-centre rule of `SCENE_FORMAT.md` section 3, clipping
+//! The view: the camera basis and pixel-centre rule of `docs/scene-format.md` section 3, clipping
 //! of world polygons to the near (and far) plane, and perspective projection to screen space.
 //!
 //! Screen space is continuous pixel coordinates: x to the right, y down, pixel `(px, py)`

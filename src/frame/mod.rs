@@ -1,4 +1,4 @@
-//! The frame: colour, and the analysis buffers of `SCENE_FORMAT.md` section 4 (face id per
+//! The frame: colour, and the analysis buffers of `docs/scene-format.md` section 4 (face id per
 //! pixel, lit fraction per light), with their PNG encodings.
 
 mod false_colour;

@@ -1,5 +1,5 @@
 //! Planar polygons in f64: Newell normals, planes, the planarity and degeneracy rules of
-//! `SCENE_FORMAT.md` section 2, clipping by a plane, point-in-polygon by the even-odd rule,
+//! `docs/scene-format.md` section 2, clipping by a plane, point-in-polygon by the even-odd rule,
 //! and Weiler-Atherton polygon clipping ([`weiler_atherton`]).
 
 pub mod even_odd;
@@ -91,7 +91,7 @@ pub enum FaceShape {
     Fan(Vec<([usize; 3], Plane)>),
 }
 
-/// Classifies a face by the planarity and degeneracy rules of `SCENE_FORMAT.md` section 2.
+/// Classifies a face by the planarity and degeneracy rules of `docs/scene-format.md` section 2.
 pub fn classify_face(verts: &[DVec3]) -> FaceShape {
     let mut idx: Vec<usize> = Vec::with_capacity(verts.len());
     for (i, &p) in verts.iter().enumerate() {

@@ -1,4 +1,4 @@
-//! Reading a scene file (`SCENE_FORMAT.md` section 1). serde does the parsing with
+//! Reading a scene file (`docs/scene-format.md` section 1). serde does the parsing with
 //! `deny_unknown_fields`; every later check keeps the span of the value it checks, so each
 //! error names the file and line.
 

@@ -1,4 +1,4 @@
-//! Scenes: the camera, materials, lights and objects of `SCENE_FORMAT.md`, and the world-space
+//! Scenes: the camera, materials, lights and objects of `docs/scene-format.md`, and the world-space
 //! polygons they compile to. Every polygon keeps its global face id.
 
 mod load;

@@ -1,5 +1,5 @@
 //! The two-pass object-space shadow algorithm of Atherton, Weiler & Greenberg ("Polygon
-//! shadow generation", SIGGRAPH 1978), as seed 004 lays it out:
+//! shadow generation", SIGGRAPH 1978), as the "Árnyékolás" notes lay it out:
 //!
 //! 1. **Hidden-surface removal from the light.** (a) The scene is transformed into the
 //!    light's view: a perspective view for point, spot and area-light samples, split into the

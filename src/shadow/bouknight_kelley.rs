@@ -1,4 +1,4 @@
-//! The scan-line shadow algorithm of Appel (1968) and Bouknight & Kelley (1970), as seed 004
+//! The scan-line shadow algorithm of Appel (1968) and Bouknight & Kelley (1970), as the "Árnyékolás" notes
 //! describes it.
 //!
 //! For every light sample:
@@ -15,8 +15,8 @@
 //!    clipped by the plane through the light parallel to B and by B's plane, and also by the
 //!    pyramid from the light over B's bounding rectangle (what falls outside it cannot fall
 //!    on B, and this keeps the projection finite), then projected from the light onto B's
-//!    plane (`Q = L − (P − L)(N·L + d)/(N·(P − L))`, seed 003; a parallel projection along
-//!    the light's direction for a directional light, seed 004's `M_par`). The shadow polygon
+//!    plane (`Q = L − (P − L)(N·L + d)/(N·(P − L))`, the "Special Effect" notes; a parallel projection along
+//!    the light's direction for a directional light, the "Árnyékolás" notes' `M_par`). The shadow polygon
 //!    A' is then put through the camera into screen space, still attached to B.
 //! 4. **Scan segments.** For each visible run on B, the shadow polygons on B are walked with
 //!    the shared edge and active-edge tables ([`super::overlay`]). Then, recursively: if no

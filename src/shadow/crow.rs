@@ -19,7 +19,7 @@
 //! - **z-fail**: the shadow polygons behind the visible point, signs reversed (counting from
 //!   infinity toward the eye), with the volumes capped.
 //! - **naive z-pass**: z-pass from zero. Wrong wherever the near plane is inside a volume
-//!   (seed 000's failure), on purpose.
+//!   (the "Rendering 6: Shadow" notes' failure), on purpose.
 //!
 //! A front cap that is the visible polygon itself lies exactly at the visible point: z-pass
 //! takes it as not in front, z-fail as behind, as a depth test `<` would. A per-polygon

@@ -1,16 +1,16 @@
 //! Blinn's planar projected shadows (J. Blinn, "Me and my (fake) shadow", IEEE CG&A 1988;
-//! seeds 000, 003, 004): every caster is flattened onto each *receiver* plane (polygons of
+//! the "Rendering 6: Shadow", "Special Effect" and "Árnyékolás" notes): every caster is flattened onto each *receiver* plane (polygons of
 //! objects marked `receiver = true`) by a projection matrix, and the flattened polygon, kept
 //! to the receiver polygon, is drawn with ambient light only.
 //!
 //! - A point light at L, plane `A x + B y + C z + D = 0` written with the light at the origin
-//!   (seed 000): `M = [[−D,0,0,0],[0,−D,0,0],[0,0,−D,0],[A,B,C,0]]`, applied as
+//!   (the "Rendering 6: Shadow" notes): `M = [[−D,0,0,0],[0,−D,0,0],[0,0,−D,0],[A,B,C,0]]`, applied as
 //!   `T(L) · M · T(−L)`. (Seed 004's `M_per`, for the plane `z = 0` and the centre of
 //!   projection at `(0, 0, −d)`, is the same matrix up to scale.)
-//! - A directional light along `(x_l, y_l, z_l)` and the plane `z = 0` (seed 004):
+//! - A directional light along `(x_l, y_l, z_l)` and the plane `z = 0` (the "Árnyékolás" notes):
 //!   `M_par = [[1,0,−x_l/z_l,0],[0,1,−y_l/z_l,0],[0,0,0,0],[0,0,0,1]]`, applied in a frame
 //!   whose `z` axis is the receiver's normal.
-//! - The stencil step (seed 003) that keeps the shadow on the receiver polygon is, on a
+//! - The stencil step (the "Special Effect" notes) that keeps the shadow on the receiver polygon is, on a
 //!   scanline, the overlay walk: a flattened polygon only darkens runs whose visible polygon
 //!   is its receiver.
 //!

@@ -1,6 +1,6 @@
-//! Shadow projection: a polygon projected from a light sample onto a plane (seed 003's
+//! Shadow projection: a polygon projected from a light sample onto a plane (the "Special Effect" notes'
 //! `Q = L − (P − L)(N·L + d)/(N·(P − L))`; for a directional light the parallel projection of
-//! seed 004's `M_par`), clipped so that only what lies between the light and the plane is
+//! the "Árnyékolás" notes' `M_par`), clipped so that only what lies between the light and the plane is
 //! projected and the result stays within a rectangle of the plane. Bouknight-Kelley projects
 //! onto each receiver; Crow projects onto the near plane for the eye's count.
 

@@ -60,7 +60,7 @@ pub enum Counting {
     /// From the visible point to infinity (Carmack's reverse / Everitt & Kilgard's z-fail).
     ZFail,
     /// From the eye to the visible point starting at zero: wrong where the eye (or the near
-    /// plane) is in shadow, as seed 000 describes; kept to show that failure.
+    /// plane) is in shadow, as the "Rendering 6: Shadow" notes describe; kept to show that failure.
     NaiveZPass,
 }
 

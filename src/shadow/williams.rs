@@ -1,6 +1,6 @@
 //! Williams' two-pass z-buffer shadows (L. Williams, "Casting curved shadows on curved
-//! surfaces", SIGGRAPH 1978; seeds 000, 002, 003, 004), with percentage-closer filtering
-//! (Reeves, Salesin & Cook 1987) and the soft-edged screen-space blur of seed 002.
+//! surfaces", SIGGRAPH 1978; the "Rendering 6: Shadow", "Special Effect" and "Árnyékolás" notes and Shastry's "Soft-Edged Shadows"), with percentage-closer filtering
+//! (Reeves, Salesin & Cook 1987) and the soft-edged screen-space blur of Shastry's "Soft-Edged Shadows".
 //!
 //! **Pass 1** renders the depth of the shadow casters from each light sample with the same
 //! z-buffer loop as visibility (`raster::rasterize`): a perspective map aimed at
@@ -8,7 +8,7 @@
 //! lights outside the scene, area-light samples), a cube of six 90° maps when it surrounds
 //! the sample, and an orthographic map fitted to the scene for a directional light. The map
 //! covers the scene, not only a spot's cone, because the lit fraction is defined outside the
-//! cone too. Optionally the polygons facing the light are culled (seed 003).
+//! cone too. Optionally the polygons facing the light are culled (the "Special Effect" notes).
 //!
 //! **Pass 2** takes each visible point into the light's map and compares: `Z_map + bias <
 //! Z_pixel` means shadow. Three remedies against acne combine (`docs/algorithms/williams.md`,
@@ -20,7 +20,7 @@
 //! kernel's radius in texels) is exact everywhere on the polygon, with no cap (off by
 //! default: at grazing angles it detaches shadows). Filters: `nearest` (one texel), `pcf`
 //! (compare each of N×N texels,
-//! then average the answers — never the depths), and `soft-edge` (seed 002: the PCF term of
+//! then average the answers — never the depths), and `soft-edge` (Shastry's "Soft-Edged Shadows": the PCF term of
 //! every pixel written to a screen-sized buffer, blurred by the seed's separable 15-tap
 //! Gaussian, and used when shading).
 
@@ -67,7 +67,7 @@ pub struct WilliamsOptions {
     pub receiver_plane: bool,
     /// Filter.
     pub filter: ShadowFilter,
-    /// Leave out polygons facing the light in pass 1 (seed 003).
+    /// Leave out polygons facing the light in pass 1 (the "Special Effect" notes).
     pub cull_front: bool,
     /// Fit each orthographic map, and each single perspective map, to the points the camera
     /// sees rather than to the whole scene (what production engines do; cube maps are not

@@ -1,4 +1,4 @@
-//! Planar mirrors: both of seed 003's methods see, through the mirror, the face that one
+//! Planar mirrors: both methods of the "Special Effect" notes see, through the mirror, the face that one
 //! ray-cast bounce sees, at every interior pixel; a mirror seen from behind reflects nothing.
 
 use crate::common;
