@@ -28,7 +28,7 @@ fn main() -> umbra::Result<()> {
         let mut img = r.frame.color_image(None);
         Frame::draw_outlines(&mut img, &r.outlines, [255, 40, 200]);
         let path = out.join(format!("{name}.png"));
-        img.save(&path).map_err(|e| umbra::Error::Image { path, source: e })?;
+        img.save(&path).map_err(|e| umbra::Error::Image { path, source: e.into() })?;
     }
     Ok(())
 }

@@ -37,7 +37,7 @@ fn main() -> umbra::Result<()> {
         imageops::replace(&mut sheet, &panel, (i as u32 * (w + gap)) as i64, 0);
     }
     let out = root.join("docs/images/williams-artefacts.png");
-    sheet.save(&out).map_err(|source| umbra::Error::Image { path: out.clone(), source })?;
+    sheet.save(&out).map_err(|e| umbra::Error::Image { path: out.clone(), source: e.into() })?;
     println!("wrote {}", out.display());
     Ok(())
 }

@@ -15,7 +15,7 @@ pub(crate) fn check(what: impl std::fmt::Display, bytes: u64) -> Result<()> {
         return Ok(());
     }
     let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
-    Err(Error::Invalid(format!(
+    Err(Error::InvalidOption(format!(
         "{what} would need about {:.1} GiB, more than umbra's memory budget of {:.0} GiB",
         gib(bytes),
         gib(MEMORY_BUDGET)

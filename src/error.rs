@@ -53,12 +53,14 @@ impl fmt::Display for FileLoc {
     }
 }
 
-/// Everything that can go wrong in umbra.
+/// Everything that can go wrong in umbra. Each message is one line; the types of the crates
+/// umbra uses underneath do not appear in it.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// Bad input at a known place: a scene or mesh that cannot be read as written.
     #[error("{loc}: {message}")]
-    Input {
+    Load {
         /// Where.
         loc: FileLoc,
         /// What is wrong, one line.
@@ -78,12 +80,12 @@ pub enum Error {
         /// The file.
         path: PathBuf,
         /// The encoder's reason.
-        source: image::ImageError,
+        source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// A request that the engine cannot carry out: an unknown method name, an option or a
     /// scene built by the API with values out of range, work beyond the memory budget.
     #[error("{0}")]
-    Invalid(String),
+    InvalidOption(String),
     /// A method that does not apply to this scene (planar shadows with no receiver).
     #[error("{0}")]
     NotApplicable(String),
@@ -95,7 +97,7 @@ pub enum Error {
 impl Error {
     /// An input error at `loc`.
     pub fn input(loc: FileLoc, message: impl Into<String>) -> Self {
-        Error::Input { loc, message: message.into() }
+        Error::Load { loc, message: message.into() }
     }
 }
 
@@ -118,6 +120,6 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 pub fn parse_named<T: Copy>(s: &str, all: &[T], name: impl Fn(T) -> &'static str, what: &str) -> Result<T> {
     all.iter().copied().find(|&m| name(m) == s).ok_or_else(|| {
         let known: Vec<&str> = all.iter().map(|&m| name(m)).collect();
-        Error::Invalid(format!("unknown {what} '{s}' (known: {})", known.join(", ")))
+        Error::InvalidOption(format!("unknown {what} '{s}' (known: {})", known.join(", ")))
     })
 }

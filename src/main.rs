@@ -110,14 +110,17 @@ impl ShadowArgs {
         for name in &self.receiver {
             if name == "auto" {
                 if scene.mark_planar_receivers().is_empty() {
-                    return Err(Error::Invalid(format!("{}: --receiver auto found no flat object", path.display())));
+                    return Err(Error::InvalidOption(format!(
+                        "{}: --receiver auto found no flat object",
+                        path.display()
+                    )));
                 }
                 continue;
             }
             let object = scene.object_named(name).or_else(|| name.parse().ok()).ok_or_else(|| {
-                Error::Invalid(format!("{}: --receiver {name}: no object of that name", path.display()))
+                Error::InvalidOption(format!("{}: --receiver {name}: no object of that name", path.display()))
             })?;
-            scene.set_receiver(object, true).map_err(|e| Error::Invalid(format!("--receiver {name}: {e}")))?;
+            scene.set_receiver(object, true).map_err(|e| Error::InvalidOption(format!("--receiver {name}: {e}")))?;
         }
         Ok(scene)
     }
@@ -337,7 +340,7 @@ fn explore(a: ExploreArgs) -> umbra::Result<()> {
     if let Some(dir) = &a.export {
         let used = std::fs::read_dir(dir).map(|mut d| d.next().is_some()).unwrap_or(false);
         if used && !a.force {
-            return Err(Error::Invalid(format!("{}: has files; pass --force to write into it", dir.display())));
+            return Err(Error::InvalidOption(format!("{}: has files; pass --force to write into it", dir.display())));
         }
         export(&explorer, dir, a.size.0, a.size.1, &ShadowMethod::ALL)?;
         return say(&format!("wrote {}: open it in a browser", dir.join("index.html").display()));
@@ -457,7 +460,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
                 ShadowMethod::Planar,
             ];
             if a.debug.is_some() && !drawn.contains(&a.shadows) {
-                return Err(Error::Invalid(format!(
+                return Err(Error::InvalidOption(format!(
                     "--debug shadow-polygons draws the polygons of bouknight-kelley, atherton-weiler-greenberg, crow \
                      and planar; {} has none to draw",
                     a.shadows
@@ -533,7 +536,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
-                .map_err(|e| Error::Invalid(format!("cannot start {threads} threads: {e}")))?;
+                .map_err(|e| Error::InvalidOption(format!("cannot start {threads} threads: {e}")))?;
             let rows = pool.install(|| {
                 umbra::study::bench::bench(&scene, &opts, |what| {
                     use std::io::Write;
@@ -553,7 +556,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
         }
         Command::Scale(a) => {
             if !a.shadow.receiver.is_empty() {
-                return Err(Error::Invalid(
+                return Err(Error::InvalidOption(
                     "--receiver marks objects of a scene file, and scale generates its scenes: it cannot be used here"
                         .into(),
                 ));
@@ -590,7 +593,10 @@ fn run(cli: Cli) -> umbra::Result<()> {
             let scene = a.shadow.load(&a.scene)?;
             let t = umbra::study::trace::trace(&scene, a.line, a.shadows, &a.shadow.options(true)?)?;
             if let Some(x) = a.x.filter(|&x| x >= scene.camera().width) {
-                return Err(Error::Invalid(format!("--x {x} is outside the image (width {})", scene.camera().width)));
+                return Err(Error::InvalidOption(format!(
+                    "--x {x} is outside the image (width {})",
+                    scene.camera().width
+                )));
             }
             if a.json {
                 let json = serde_json::to_string_pretty(&t).map_err(|e| Error::Internal(e.to_string()))?;
@@ -604,7 +610,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
         Command::ExportShadows(e) => {
             let scene = Scene::load(&e.scene)?;
             if e.light >= scene.lights().len() {
-                return Err(Error::Invalid(format!(
+                return Err(Error::InvalidOption(format!(
                     "{}: no light {} (the scene has {} light(s), numbered from 0)",
                     e.scene.display(),
                     e.light,
@@ -644,7 +650,9 @@ fn run(cli: Cli) -> umbra::Result<()> {
 /// Refuses to write over files that exist, unless told to (`--force`).
 fn refuse_overwrite(paths: &[PathBuf], force: bool) -> umbra::Result<()> {
     match paths.iter().find(|p| p.exists()) {
-        Some(p) if !force => Err(Error::Invalid(format!("{}: exists; pass --force to overwrite it", p.display()))),
+        Some(p) if !force => {
+            Err(Error::InvalidOption(format!("{}: exists; pass --force to overwrite it", p.display())))
+        }
         _ => Ok(()),
     }
 }
@@ -689,7 +697,7 @@ fn check_png_name(path: &std::path::Path) -> umbra::Result<()> {
     if ext.is_none() || ext.as_deref() == Some("png") {
         return Ok(());
     }
-    Err(Error::Invalid(format!("{}: umbra writes PNG only; name the output file *.png", path.display())))
+    Err(Error::InvalidOption(format!("{}: umbra writes PNG only; name the output file *.png", path.display())))
 }
 
 /// Writes the image as PNG, in one write so that a failed write is an error.
@@ -697,7 +705,7 @@ fn write_png(img: image::RgbImage, path: &std::path::Path) -> umbra::Result<()> 
     check_png_name(path)?;
     let mut bytes = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| Error::Image { path: path.to_owned(), source: e })?;
+        .map_err(|e| Error::Image { path: path.to_owned(), source: e.into() })?;
     std::fs::write(path, bytes).map_err(|e| Error::Io { path: path.to_owned(), source: e })
 }
 

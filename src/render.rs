@@ -187,7 +187,7 @@ fn frame_pass(
 ) -> Result<(Rendered, FrameRuns)> {
     let start = Instant::now();
     // The camera is a public field: a program may have changed it since the scene was built.
-    scene.camera.validate().map_err(crate::error::Error::Invalid)?;
+    scene.camera.validate().map_err(crate::error::Error::InvalidOption)?;
     check_frame_memory(scene, opts)?;
     let mut stats = Stats {
         visibility: opts.visibility.name().into(),

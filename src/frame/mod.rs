@@ -237,7 +237,7 @@ pub fn check_gamma(gamma: f32) -> Result<()> {
     if GAMMA_RANGE.contains(&gamma) {
         Ok(())
     } else {
-        Err(Error::Invalid(format!(
+        Err(Error::InvalidOption(format!(
             "gamma {gamma} is not in {}..={} (2.2 is the usual display gamma)",
             GAMMA_RANGE.start(),
             GAMMA_RANGE.end()
@@ -261,7 +261,7 @@ pub(crate) fn encode_png(img: image::DynamicImage) -> Result<Vec<u8>> {
 fn png_bytes(img: &image::DynamicImage, path: &Path) -> Result<Vec<u8>> {
     let mut bytes = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| Error::Image { path: path.to_owned(), source: e })?;
+        .map_err(|e| Error::Image { path: path.to_owned(), source: e.into() })?;
     Ok(bytes)
 }
 

@@ -382,7 +382,7 @@ impl Scene {
             });
         }
         Scene::new(camera, render, materials, lights, objects).map_err(|e| match e {
-            Error::Invalid(m) => Error::input(FileLoc::file(file), m),
+            Error::InvalidOption(m) => Error::input(FileLoc::file(file), m),
             e => e,
         })
     }

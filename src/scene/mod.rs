@@ -471,16 +471,16 @@ impl Scene {
         lights: Vec<Light>,
         objects: Vec<Object>,
     ) -> Result<Scene> {
-        camera.validate().map_err(Error::Invalid)?;
+        camera.validate().map_err(Error::InvalidOption)?;
         for (i, l) in lights.iter().enumerate() {
-            l.validate().map_err(|m| Error::Invalid(format!("light {i}: {m}")))?;
+            l.validate().map_err(|m| Error::InvalidOption(format!("light {i}: {m}")))?;
         }
         if materials.is_empty() {
             materials.push(Material::new("default"));
         }
         for (i, o) in objects.iter().enumerate() {
             if o.material >= materials.len() {
-                return Err(Error::Invalid(format!("object {i}: material index {} out of range", o.material)));
+                return Err(Error::InvalidOption(format!("object {i}: material index {} out of range", o.material)));
             }
             let m = &o.mesh;
             let bad = m.faces.iter().any(|f| {
@@ -489,12 +489,12 @@ impl Scene {
                     || (!f.normals.is_empty() && f.normals.len() != f.vertices.len())
             });
             if bad {
-                return Err(Error::Invalid(format!("object {i}: face index out of range")));
+                return Err(Error::InvalidOption(format!("object {i}: face index out of range")));
             }
             let finite = m.positions.iter().chain(&m.normals).all(|p| p.is_finite());
             let t = &o.transform;
             if !(finite && t.scale.is_finite() && t.rotate.is_finite() && t.translate.is_finite()) {
-                return Err(Error::Invalid(format!("object {i}: non-finite coordinate")));
+                return Err(Error::InvalidOption(format!("object {i}: non-finite coordinate")));
             }
         }
         let mut scene = Scene {
@@ -508,7 +508,7 @@ impl Scene {
             normals: Vec::new(),
             face_count: 0,
         };
-        scene.compile().map_err(Error::Invalid)?;
+        scene.compile().map_err(Error::InvalidOption)?;
         Ok(scene)
     }
 
@@ -597,7 +597,7 @@ impl Scene {
     /// # Ok::<(), umbra::Error>(())
     /// ```
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
-        camera.validate().map_err(Error::Invalid)?;
+        camera.validate().map_err(Error::InvalidOption)?;
         self.camera = camera;
         Ok(())
     }
@@ -619,10 +619,10 @@ impl Scene {
             materials.push(Material::new("default"));
         }
         for m in &materials {
-            m.validate().map_err(|e| Error::Invalid(format!("material '{}': {e}", m.name)))?;
+            m.validate().map_err(|e| Error::InvalidOption(format!("material '{}': {e}", m.name)))?;
         }
         if let Some((i, o)) = self.objects.iter().enumerate().find(|(_, o)| o.material >= materials.len()) {
-            return Err(Error::Invalid(format!("object {i}: material index {} out of range", o.material)));
+            return Err(Error::InvalidOption(format!("object {i}: material index {} out of range", o.material)));
         }
         self.materials = materials;
         Ok(())
@@ -636,7 +636,7 @@ impl Scene {
     /// Replaces the lights, after the checks the loader makes.
     pub fn set_lights(&mut self, lights: Vec<Light>) -> Result<()> {
         for (i, l) in lights.iter().enumerate() {
-            l.validate().map_err(|m| Error::Invalid(format!("light {i}: {m}")))?;
+            l.validate().map_err(|m| Error::InvalidOption(format!("light {i}: {m}")))?;
         }
         self.lights = lights;
         Ok(())
@@ -653,7 +653,7 @@ impl Scene {
         let o = self
             .objects
             .get_mut(object)
-            .ok_or_else(|| Error::Invalid(format!("no object {object} (the scene has {count})")))?;
+            .ok_or_else(|| Error::InvalidOption(format!("no object {object} (the scene has {count})")))?;
         o.receiver = receiver;
         Ok(())
     }

@@ -432,7 +432,10 @@ impl ShadowDatabase {
     /// independent, and are sorted in parallel.
     pub fn build(scene: &Scene, light: usize, counters: &mut Counters) -> Result<ShadowDatabase> {
         let l = scene.lights.get(light).ok_or_else(|| {
-            Error::Invalid(format!("no light {light}: the scene has {} light(s), numbered from 0", scene.lights.len()))
+            Error::InvalidOption(format!(
+                "no light {light}: the scene has {} light(s), numbered from 0",
+                scene.lights.len()
+            ))
         })?;
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
         let t = Instant::now();
@@ -506,7 +509,9 @@ impl<'a> AthertonWeilerGreenberg<'a> {
     pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Result<Self> {
         let databases: Arc<Vec<ShadowDatabase>> = match &ctx.options.awg_database {
             Some(db) if db.len() == ctx.scene.lights.len() => db.clone(),
-            Some(_) => return Err(Error::Invalid("the shadow database does not match the scene's lights".into())),
+            Some(_) => {
+                return Err(Error::InvalidOption("the shadow database does not match the scene's lights".into()))
+            }
             None => Arc::new(
                 (0..ctx.scene.lights.len())
                     .map(|l| ShadowDatabase::build(ctx.scene, l, counters))

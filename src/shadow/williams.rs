@@ -101,7 +101,7 @@ impl WilliamsOptions {
     /// [`Self::MAX_MAP_SIZE`] texels, an odd kernel side of 1 to [`Self::MAX_KERNEL`] and no
     /// wider than the map, and biases that are finite and not negative.
     pub fn check(&self) -> Result<()> {
-        let fail = |what: String| Err(Error::Invalid(format!("williams: {what}")));
+        let fail = |what: String| Err(Error::InvalidOption(format!("williams: {what}")));
         if !(1..=Self::MAX_MAP_SIZE).contains(&self.map_size) {
             return fail(format!("map size {} is not in 1..={}", self.map_size, Self::MAX_MAP_SIZE));
         }

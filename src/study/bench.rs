@@ -106,7 +106,7 @@ pub fn measure(scene: &Scene, opts: &RenderOptions, warmup: usize, runs: usize) 
 /// starts.
 pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<Vec<BenchRow>> {
     if o.runs == 0 {
-        return Err(Error::Invalid("bench needs at least one timed run".into()));
+        return Err(Error::InvalidOption("bench needs at least one timed run".into()));
     }
     let mut rows = Vec::new();
     for &v in &o.visibility {

@@ -157,7 +157,7 @@ impl Explorer {
                 "height" => r.height = side("height", &value)?,
                 "light" => r.light = Some(point(&value)?),
                 "line" | "index" => {}
-                _ => return Err(Error::Invalid(format!("unknown parameter '{key}'"))),
+                _ => return Err(Error::InvalidOption(format!("unknown parameter '{key}'"))),
             }
         }
         Ok(r)
@@ -173,14 +173,14 @@ impl Explorer {
             let mut lights = scene.lights().to_vec();
             let middle = scene.bounds().map_or(DVec3::ZERO, |(lo, hi)| (lo + hi) / 2.0);
             let Some(first) = lights.first_mut() else {
-                return Err(Error::Invalid("the scene has no light to move".into()));
+                return Err(Error::InvalidOption("the scene has no light to move".into()));
             };
             match &mut first.kind {
                 LightKind::Point { position } | LightKind::Spot { position, .. } => *position = p,
                 LightKind::Area { corner, .. } => *corner = p,
                 LightKind::Directional { direction } => {
                     *direction = crate::geometry::unit(middle - p)
-                        .ok_or_else(|| Error::Invalid("the light is at the middle of the scene".into()))?
+                        .ok_or_else(|| Error::InvalidOption("the light is at the middle of the scene".into()))?
                 }
             }
             scene.set_lights(lights)?;
@@ -233,16 +233,19 @@ impl Explorer {
         let index = pairs(query).find(|(k, _)| k == "index").map_or(Ok(0), |(_, v)| v.parse::<usize>());
         match index.ok().and_then(|i| shown.pictures.get(i)) {
             Some(png) => Ok(Response::ok("image/png", png.clone())),
-            None => Err(Error::Invalid(format!("no such picture (this stage has {})", shown.pictures.len()))),
+            None => Err(Error::InvalidOption(format!("no such picture (this stage has {})", shown.pictures.len()))),
         }
     }
 
     /// Traces the requested line.
     fn trace(&self, query: &str) -> Result<LineTrace> {
         let r = self.request(query)?;
-        let line =
-            pairs(query).find(|(k, _)| k == "line").ok_or_else(|| Error::Invalid("missing parameter 'line'".into()))?.1;
-        let line: u32 = line.parse().map_err(|_| Error::Invalid(format!("line '{line}' is not a line number")))?;
+        let line = pairs(query)
+            .find(|(k, _)| k == "line")
+            .ok_or_else(|| Error::InvalidOption("missing parameter 'line'".into()))?
+            .1;
+        let line: u32 =
+            line.parse().map_err(|_| Error::InvalidOption(format!("line '{line}' is not a line number")))?;
         let scene = self.scene_for(&r)?;
         trace(&scene, line, r.shadows, &traced())
     }
@@ -345,7 +348,7 @@ fn decode(s: &str) -> String {
 fn side(name: &str, value: &str) -> Result<u32> {
     match value.parse::<u32>() {
         Ok(v) if (1..=MAX_SIDE).contains(&v) => Ok(v),
-        _ => Err(Error::Invalid(format!("{name} '{value}' is not a whole number from 1 to {MAX_SIDE}"))),
+        _ => Err(Error::InvalidOption(format!("{name} '{value}' is not a whole number from 1 to {MAX_SIDE}"))),
     }
 }
 
@@ -353,7 +356,7 @@ fn point(value: &str) -> Result<DVec3> {
     let v: Vec<f64> = value.split(',').filter_map(|c| c.trim().parse().ok()).filter(|c: &f64| c.is_finite()).collect();
     match v[..] {
         [x, y, z] if value.split(',').count() == 3 => Ok(DVec3::new(x, y, z)),
-        _ => Err(Error::Invalid(format!("light '{value}' is not three finite numbers x,y,z"))),
+        _ => Err(Error::InvalidOption(format!("light '{value}' is not three finite numbers x,y,z"))),
     }
 }
 
@@ -362,7 +365,7 @@ fn point(value: &str) -> Result<DVec3> {
 /// engine's work off the server's own threads.
 pub fn serve(explorer: Explorer, port: u16, ready: impl FnOnce(&str)) -> Result<()> {
     use axum::http::{header, Method, StatusCode, Uri};
-    let failed = |what: &str, e: std::io::Error| Error::Invalid(format!("{what}: {e}"));
+    let failed = |what: &str, e: std::io::Error| Error::InvalidOption(format!("{what}: {e}"));
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_io()
         .build()

@@ -42,7 +42,7 @@ pub(crate) fn save(chart: &impl Chart, stem: &Path) -> Result<()> {
     let (svg, png) = (stem.with_extension("svg"), stem.with_extension("png"));
     let fail = |path: &Path| {
         let path = path.display().to_string();
-        move |e: String| Error::Invalid(format!("{path}: cannot draw the chart: {e}"))
+        move |e: String| Error::InvalidOption(format!("{path}: cannot draw the chart: {e}"))
     };
     let size = chart.size();
     let root = SVGBackend::new(&svg, size).into_drawing_area();

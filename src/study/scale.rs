@@ -145,7 +145,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     std::fs::create_dir_all(&o.out).map_err(|e| Error::Io { path: o.out.clone(), source: e })?;
     let (kind, name) = o.counter.split_once('.').unwrap_or(("visibility", &o.counter));
     if kind != "visibility" && kind != "shadow" {
-        return Err(Error::Invalid(format!("counter '{}' is not visibility.NAME or shadow.NAME", o.counter)));
+        return Err(Error::InvalidOption(format!("counter '{}' is not visibility.NAME or shadow.NAME", o.counter)));
     }
     let mut points = Vec::new();
     let mut known = std::collections::BTreeSet::new();
@@ -176,7 +176,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         // knows would plot zeros everywhere.
         if i == 0 && !known.contains(name) {
             let names: Vec<&str> = known.iter().copied().collect();
-            return Err(Error::Invalid(format!(
+            return Err(Error::InvalidOption(format!(
                 "no method here counts '{}' (known {kind} counters: {})",
                 o.counter,
                 names.join(", ")

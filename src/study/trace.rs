@@ -94,7 +94,7 @@ pub fn trace_lines(
 ) -> Result<()> {
     let view = View::new(&scene.camera);
     if lines.end > view.height || lines.is_empty() {
-        return Err(Error::Invalid(format!(
+        return Err(Error::InvalidOption(format!(
             "line {} is outside the image (height {})",
             lines.end.saturating_sub(1).max(lines.start),
             view.height
