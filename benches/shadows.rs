@@ -6,14 +6,14 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use std::sync::Arc;
 use std::time::Duration;
-use umbra::shadow::{ShadowDatabase, ShadowFilter, ShadowOptions, WilliamsOptions};
-use umbra::{generate, render, Counters, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
+use umbra::shadow::{BouknightKelleyOptions, ShadowDatabase, ShadowFilter, WilliamsOptions};
+use umbra::{generate, render, Counters, RenderOptions, Renderer, Scene, ShadowMethod, VisibilityMethod};
 
 const W: u32 = 1920;
 const H: u32 = 1080;
 
-fn opts(shadows: ShadowMethod, shadow_options: ShadowOptions) -> RenderOptions {
-    RenderOptions { visibility: VisibilityMethod::Scanline, shadows, shadow_options, ..RenderOptions::default() }
+fn opts(shadows: ShadowMethod) -> RenderOptions {
+    RenderOptions { visibility: VisibilityMethod::Scanline, shadows, ..RenderOptions::default() }
 }
 
 fn group<'a>(c: &'a mut Criterion, name: &str) -> criterion::BenchmarkGroup<'a, criterion::measurement::WallTime> {
@@ -32,27 +32,22 @@ fn stages(c: &mut Criterion) {
     let mut g = group(c, "shadows");
     for (name, scene) in &scenes {
         let mut methods = vec![
-            ("none", ShadowMethod::None, ShadowOptions::default()),
-            ("bouknight-kelley", ShadowMethod::BouknightKelley, ShadowOptions::default()),
-            ("crow", ShadowMethod::Crow, ShadowOptions::default()),
-            ("williams-2048", ShadowMethod::Williams, ShadowOptions::default()),
-            ("stencil-volume", ShadowMethod::StencilVolume, ShadowOptions::default()),
-            ("ray-cast", ShadowMethod::RayCast, ShadowOptions::default()),
+            ("none", ShadowMethod::None),
+            ("bouknight-kelley", ShadowMethod::BouknightKelley(Default::default())),
+            ("crow", ShadowMethod::Crow(Default::default())),
+            ("williams-2048", ShadowMethod::Williams(Default::default())),
+            ("stencil-volume", ShadowMethod::StencilVolume(Default::default())),
+            ("ray-cast", ShadowMethod::RayCast),
         ];
         if *name != "sphere100k" {
-            methods.push((
-                "atherton-weiler-greenberg",
-                ShadowMethod::AthertonWeilerGreenberg,
-                ShadowOptions::default(),
-            ));
+            methods.push(("atherton-weiler-greenberg", ShadowMethod::AthertonWeilerGreenberg));
             methods.push((
                 "bouknight-kelley-no-prefilter",
-                ShadowMethod::BouknightKelley,
-                ShadowOptions { prefilter: false, ..Default::default() },
+                ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false }),
             ));
         }
-        for (label, m, o) in methods {
-            let o = opts(m, o);
+        for (label, m) in methods {
+            let o = opts(m);
             g.bench_with_input(BenchmarkId::new(label, name), scene, |b, s| b.iter(|| render(s, &o).unwrap()));
         }
     }
@@ -69,11 +64,11 @@ fn atherton_weiler_greenberg(c: &mut Criterion) {
             b.iter(|| ShadowDatabase::build(&scene, 0, &mut Counters::default()).unwrap())
         });
         let db = Arc::new(vec![ShadowDatabase::build(&scene, 0, &mut Counters::default()).unwrap()]);
-        let view_pass = opts(
-            ShadowMethod::AthertonWeilerGreenberg,
-            ShadowOptions { awg_database: Some(db.clone()), ..Default::default() },
-        );
-        g.bench_function(BenchmarkId::new("view-pass", name), |b| b.iter(|| render(&scene, &view_pass).unwrap()));
+        let view_pass = opts(ShadowMethod::AthertonWeilerGreenberg);
+        let mut renderer = Renderer::new().with_shadow_database(db.clone());
+        g.bench_function(BenchmarkId::new("view-pass", name), |b| {
+            b.iter(|| renderer.render(&scene, &view_pass).unwrap().stats.polygons)
+        });
         let mut views = Vec::new();
         for k in 0..10 {
             let mut s = scene.clone();
@@ -85,7 +80,7 @@ fn atherton_weiler_greenberg(c: &mut Criterion) {
             views.push(s);
         }
         g.bench_function(BenchmarkId::new("ten-views-one-database", name), |b| {
-            b.iter(|| views.iter().map(|s| render(s, &view_pass).unwrap().stats.polygons).sum::<usize>())
+            b.iter(|| views.iter().map(|s| renderer.render(s, &view_pass).unwrap().stats.polygons).sum::<usize>())
         });
     }
     g.finish();
@@ -99,7 +94,7 @@ fn planar(c: &mut Criterion) {
         ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap()),
     ] {
         scene.set_receiver(0, true).unwrap();
-        let o = opts(ShadowMethod::Planar, ShadowOptions::default());
+        let o = opts(ShadowMethod::Planar);
         g.bench_function(BenchmarkId::new("planar", name), |b| b.iter(|| render(&scene, &o).unwrap()));
     }
     g.finish();
@@ -113,16 +108,13 @@ fn williams(c: &mut Criterion) {
         ("cubes10", generate::cubes(10, true, W, H).unwrap()),
         ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap()),
     ] {
-        let nearest = ShadowOptions {
-            williams: WilliamsOptions { filter: ShadowFilter::Nearest, ..Default::default() },
-            ..Default::default()
-        };
-        for (label, visibility, m, o) in [
-            ("zbuffer-none", VisibilityMethod::ZBuffer, ShadowMethod::None, ShadowOptions::default()),
-            ("zbuffer-williams-2048", VisibilityMethod::ZBuffer, ShadowMethod::Williams, ShadowOptions::default()),
-            ("scanline-williams-2048-nearest", VisibilityMethod::Scanline, ShadowMethod::Williams, nearest),
+        let nearest = WilliamsOptions { filter: ShadowFilter::Nearest, ..Default::default() };
+        for (label, visibility, m) in [
+            ("zbuffer-none", VisibilityMethod::ZBuffer, ShadowMethod::None),
+            ("zbuffer-williams-2048", VisibilityMethod::ZBuffer, ShadowMethod::Williams(Default::default())),
+            ("scanline-williams-2048-nearest", VisibilityMethod::Scanline, ShadowMethod::Williams(nearest.clone())),
         ] {
-            let o = RenderOptions { visibility, ..opts(m, o) };
+            let o = RenderOptions { visibility, ..opts(m) };
             g.bench_with_input(BenchmarkId::new(label, name), &scene, |b, s| b.iter(|| render(s, &o).unwrap()));
         }
     }

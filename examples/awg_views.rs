@@ -2,8 +2,8 @@
 //! renders it from the scene's camera and from a second viewpoint, the lit detail polygons
 //! drawn over each image: `cargo run --release --example awg_views SCENE OUT_DIR`.
 use std::sync::Arc;
-use umbra::shadow::{ShadowDatabase, ShadowOptions};
-use umbra::{render, Counters, Frame, RenderOptions, Scene, ShadowMethod};
+use umbra::shadow::ShadowDatabase;
+use umbra::{Counters, Frame, RenderOptions, Renderer, Scene, ShadowMethod};
 
 fn main() -> umbra::Result<()> {
     let args: Vec<String> = std::env::args().collect();
@@ -12,11 +12,8 @@ fn main() -> umbra::Result<()> {
     let mut counters = Counters::default();
     let db = Arc::new(vec![ShadowDatabase::build(&scene, 0, &mut counters)?]);
     println!("{}", serde_json::to_string(&counters).unwrap_or_default());
-    let opts = RenderOptions {
-        shadows: ShadowMethod::AthertonWeilerGreenberg,
-        shadow_options: ShadowOptions { awg_database: Some(db), keep_outlines: true, ..Default::default() },
-        ..Default::default()
-    };
+    let opts = RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg, outlines: true, ..Default::default() };
+    let mut renderer = Renderer::new().with_shadow_database(db);
     std::fs::create_dir_all(out).map_err(|e| umbra::Error::Io { path: out.to_owned(), source: e })?;
     for (name, eye) in [("awg-detail", scene.camera().eye), ("awg-second-view", glam::DVec3::new(2.2, 4.8, 2.6))] {
         {
@@ -24,7 +21,7 @@ fn main() -> umbra::Result<()> {
             c.eye = eye;
             scene.set_camera(c).expect("a valid camera");
         }
-        let r = render(&scene, &opts)?;
+        let r = renderer.render(&scene, &opts)?;
         let mut img = r.frame.color_image(None);
         Frame::draw_outlines(&mut img, &r.outlines, [255, 40, 200]);
         let path = out.join(format!("{name}.png"));

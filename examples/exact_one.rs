@@ -1,18 +1,22 @@
 //! Pixels where one shadow stage differs from ray-cast on a scene, and how many of those are
 //! ties: `cargo run --release --example exact_one -- scene.toml crow [zfail]`.
 use umbra::shadow::volumes::Counting;
-use umbra::shadow::ShadowOptions;
+use umbra::shadow::VolumeOptions;
 use umbra::{render, RenderOptions, Scene, ShadowMethod};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let scene = Scene::load(&a[1]).unwrap();
     let method: ShadowMethod = a[2].parse().unwrap();
-    let crow_count = if a.get(3).is_some_and(|c| c == "zfail") { Counting::ZFail } else { Counting::ZPass };
-    let go =
-        |s, o| render(&scene, &RenderOptions { shadows: s, shadow_options: o, ..Default::default() }).unwrap().frame;
-    let want = go(ShadowMethod::RayCast, ShadowOptions::default());
-    let got = go(method, ShadowOptions { crow_count, ..Default::default() });
+    let counting = if a.get(3).is_some_and(|c| c == "zfail") { Counting::ZFail } else { Counting::ZPass };
+    let method = match method {
+        ShadowMethod::Crow(_) => ShadowMethod::Crow(VolumeOptions { counting, ..Default::default() }),
+        ShadowMethod::StencilVolume(_) => ShadowMethod::StencilVolume(VolumeOptions { counting, ..Default::default() }),
+        other => other,
+    };
+    let go = |s| render(&scene, &RenderOptions { shadows: s, ..Default::default() }).unwrap().frame;
+    let want = go(ShadowMethod::RayCast);
+    let got = go(method);
     let oracle = umbra::reference::Reference::new(&scene);
     let (mut differ, mut ties) = (0, 0);
     for y in 0..want.height {

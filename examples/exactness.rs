@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release --example exactness -- scene.toml [more.toml ...]`
 use umbra::shadow::volumes::Counting;
-use umbra::shadow::ShadowOptions;
+use umbra::shadow::VolumeOptions;
 use umbra::{render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 fn main() {
@@ -15,22 +15,20 @@ fn main() {
                 continue;
             }
         };
-        let go = |v, s, o: ShadowOptions| {
-            render(&scene, &RenderOptions { visibility: v, shadows: s, shadow_options: o, ..Default::default() })
-        };
-        let reference = go(VisibilityMethod::RayCast, ShadowMethod::RayCast, ShadowOptions::default()).unwrap().frame;
-        let d = ShadowOptions::default;
+        let go = |v, s| render(&scene, &RenderOptions { visibility: v, shadows: s, ..Default::default() });
+        let reference = go(VisibilityMethod::RayCast, ShadowMethod::RayCast).unwrap().frame;
+        let volumes = |counting| VolumeOptions { counting, ..VolumeOptions::default() };
         let stages = [
-            ("bk", ShadowMethod::BouknightKelley, d()),
-            ("awg", ShadowMethod::AthertonWeilerGreenberg, d()),
-            ("crow-zpass", ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZPass, ..d() }),
-            ("crow-zfail", ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZFail, ..d() }),
-            ("stencil-zpass", ShadowMethod::StencilVolume, ShadowOptions { crow_count: Counting::ZPass, ..d() }),
-            ("stencil-zfail", ShadowMethod::StencilVolume, ShadowOptions { crow_count: Counting::ZFail, ..d() }),
+            ("bk", ShadowMethod::DEFAULT),
+            ("awg", ShadowMethod::AthertonWeilerGreenberg),
+            ("crow-zpass", ShadowMethod::Crow(volumes(Counting::ZPass))),
+            ("crow-zfail", ShadowMethod::Crow(volumes(Counting::ZFail))),
+            ("stencil-zpass", ShadowMethod::StencilVolume(volumes(Counting::ZPass))),
+            ("stencil-zfail", ShadowMethod::StencilVolume(volumes(Counting::ZFail))),
         ];
         for vis in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
-            for (name, s, o) in &stages {
-                match go(vis, *s, o.clone()) {
+            for (name, s) in &stages {
+                match go(vis, s.clone()) {
                     Err(e) => println!("{path} {vis} {name}: error {e}"),
                     Ok(out) => {
                         let f = out.frame;

@@ -2,7 +2,7 @@
 //! rendered with five shadow-map settings, side by side, written to
 //! `docs/images/williams-artefacts.png`. `cargo run --release --example williams_artefacts`.
 use image::{imageops, RgbImage};
-use umbra::shadow::{ShadowFilter, ShadowOptions, WilliamsOptions};
+use umbra::shadow::{ShadowFilter, WilliamsOptions};
 use umbra::{render, RenderOptions, Scene, ShadowMethod};
 
 fn main() -> umbra::Result<()> {
@@ -30,8 +30,7 @@ fn main() -> umbra::Result<()> {
     let (w, h, gap) = (320, 240, 4);
     let mut sheet = RgbImage::new(panels.len() as u32 * (w + gap) - gap, h);
     for (i, williams) in panels.into_iter().enumerate() {
-        let shadow_options = ShadowOptions { williams, ..Default::default() };
-        let opts = RenderOptions { shadows: ShadowMethod::Williams, shadow_options, ..Default::default() };
+        let opts = RenderOptions { shadows: ShadowMethod::Williams(williams), ..Default::default() };
         let image = render(&scene, &opts)?.frame.color_image(None);
         let panel = imageops::resize(&image, w, h, imageops::FilterType::Triangle);
         imageops::replace(&mut sheet, &panel, (i as u32 * (w + gap)) as i64, 0);

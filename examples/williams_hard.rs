@@ -2,7 +2,7 @@
 //! `NORMAL` in the environment set the slope bias and the normal offset) differs from
 //! ray-cast, for each scene given:
 //! `cargo run --release --example williams_hard -- scenes/grazing-light.toml ...`
-use umbra::shadow::{ShadowOptions, WilliamsOptions};
+use umbra::shadow::WilliamsOptions;
 use umbra::study::compare::diff;
 use umbra::{render, RenderOptions, Scene, ShadowMethod};
 
@@ -21,11 +21,7 @@ fn main() {
             map_size: var("MAP").map_or(d.map_size, |m| m as u32),
             ..d
         };
-        let opts = RenderOptions {
-            shadows: ShadowMethod::Williams,
-            shadow_options: ShadowOptions { williams, ..Default::default() },
-            ..Default::default()
-        };
+        let opts = RenderOptions { shadows: ShadowMethod::Williams(williams), ..Default::default() };
         let got = render(&scene, &opts).unwrap().frame;
         let (interior, wrong, _) = diff(&reference, &got);
         println!(

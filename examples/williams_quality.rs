@@ -2,7 +2,7 @@
 //! 4096 and several biases, the share of interior pixels whose lit value differs from the
 //! ray-cast reference (measured as `umbra compare` measures it) and the render time,
 //! printed as a Markdown table. `cargo run --release --example williams_quality`.
-use umbra::shadow::{ShadowFilter, ShadowOptions, WilliamsOptions};
+use umbra::shadow::{ShadowFilter, WilliamsOptions};
 use umbra::study::compare::diff;
 use umbra::{render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
@@ -51,11 +51,7 @@ fn main() {
                         filter,
                         ..Default::default()
                     };
-                    let opts = RenderOptions {
-                        shadows: ShadowMethod::Williams,
-                        shadow_options: ShadowOptions { williams, ..Default::default() },
-                        ..Default::default()
-                    };
+                    let opts = RenderOptions { shadows: ShadowMethod::Williams(williams), ..Default::default() };
                     let mut times = Vec::new();
                     let mut frame = None;
                     for _ in 0..3 {

@@ -117,9 +117,14 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Finds the item of `all` whose `name` is `s`; otherwise an error naming what was asked for
 /// and listing the known names (for every method chosen by name on the command line).
-pub fn parse_named<T: Copy>(s: &str, all: &[T], name: impl Fn(T) -> &'static str, what: &str) -> Result<T> {
-    all.iter().copied().find(|&m| name(m) == s).ok_or_else(|| {
-        let known: Vec<&str> = all.iter().map(|&m| name(m)).collect();
+pub(crate) fn parse_named<'a, T>(
+    s: &str,
+    all: &'a [T],
+    name: impl Fn(&T) -> &'static str,
+    what: &str,
+) -> Result<&'a T> {
+    all.iter().find(|m| name(m) == s).ok_or_else(|| {
+        let known: Vec<&str> = all.iter().map(name).collect();
         Error::InvalidOption(format!("unknown {what} '{s}' (known: {})", known.join(", ")))
     })
 }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use umbra::reflection::ReflectionMethod;
 use umbra::shadow::volumes::Counting;
-use umbra::shadow::{ShadowFilter, ShadowOptions, WilliamsOptions};
+use umbra::shadow::{BouknightKelleyOptions, ShadowFilter, VolumeOptions, WilliamsOptions};
 use umbra::study::compare::{compare, CompareOptions};
 use umbra::study::scale::{scale, ScaleOptions, Sweep};
 use umbra::{generate, render, Error, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
@@ -125,17 +125,21 @@ impl ShadowArgs {
         Ok(scene)
     }
 
-    fn options(&self, keep_outlines: bool) -> umbra::Result<ShadowOptions> {
+    /// `method` with the settings these flags give it (each flag sets its own method's).
+    fn configure(&self, method: ShadowMethod) -> ShadowMethod {
         let filter = match self.shadow_filter {
             FilterArg::Nearest => ShadowFilter::Nearest,
             FilterArg::Pcf => ShadowFilter::Pcf(self.pcf_size),
             FilterArg::SoftEdge => ShadowFilter::SoftEdge(self.pcf_size),
         };
-        Ok(ShadowOptions {
-            prefilter: !self.no_prefilter,
-            crow_count: self.crow_count,
-            silhouettes: !self.no_silhouettes,
-            williams: WilliamsOptions {
+        let volumes = VolumeOptions { counting: self.crow_count, silhouettes: !self.no_silhouettes };
+        match method {
+            ShadowMethod::BouknightKelley(_) => {
+                ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: !self.no_prefilter })
+            }
+            ShadowMethod::Crow(_) => ShadowMethod::Crow(volumes),
+            ShadowMethod::StencilVolume(_) => ShadowMethod::StencilVolume(volumes),
+            ShadowMethod::Williams(_) => ShadowMethod::Williams(WilliamsOptions {
                 map_size: self.map_size,
                 bias: self.bias,
                 slope_bias: self.slope_bias,
@@ -144,10 +148,14 @@ impl ShadowArgs {
                 filter,
                 cull_front: self.cull_front,
                 fit_to_view: !self.no_fit,
-            },
-            awg_database: None,
-            keep_outlines,
-        })
+            }),
+            other => other,
+        }
+    }
+
+    /// Every method of `methods` configured by these flags.
+    fn configure_all(&self, methods: Vec<ShadowMethod>) -> Vec<ShadowMethod> {
+        methods.into_iter().map(|m| self.configure(m)).collect()
     }
 }
 
@@ -453,13 +461,14 @@ fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
         Command::Render(a) => {
             check_png_name(&a.output)?;
-            let drawn = [
-                ShadowMethod::BouknightKelley,
-                ShadowMethod::AthertonWeilerGreenberg,
-                ShadowMethod::Crow,
-                ShadowMethod::Planar,
-            ];
-            if a.debug.is_some() && !drawn.contains(&a.shadows) {
+            let drawn = matches!(
+                a.shadows,
+                ShadowMethod::BouknightKelley(_)
+                    | ShadowMethod::AthertonWeilerGreenberg
+                    | ShadowMethod::Crow(_)
+                    | ShadowMethod::Planar
+            );
+            if a.debug.is_some() && !drawn {
                 return Err(Error::InvalidOption(format!(
                     "--debug shadow-polygons draws the polygons of bouknight-kelley, atherton-weiler-greenberg, crow \
                      and planar; {} has none to draw",
@@ -469,11 +478,11 @@ fn run(cli: Cli) -> umbra::Result<()> {
             let scene = a.shadow.load(&a.scene)?;
             let opts = RenderOptions {
                 visibility: a.visibility,
-                shadows: a.shadows,
-                shadow_options: a.shadow.options(a.debug.is_some())?,
+                shadows: a.shadow.configure(a.shadows.clone()),
                 progress: true,
                 pixel_counters: a.aov.is_some(),
                 reflection: a.reflection,
+                outlines: a.debug.is_some(),
             };
             let out = render(&scene, &opts)?;
             let mut img = out.frame.color_image(a.gamma);
@@ -498,8 +507,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
             let d = CompareOptions::default();
             let opts = CompareOptions {
                 visibility: if a.visibility.is_empty() { d.visibility } else { a.visibility },
-                shadows: if a.shadows.is_empty() { d.shadows } else { a.shadows },
-                shadow_options: a.shadow.options(false)?,
+                shadows: a.shadow.configure_all(if a.shadows.is_empty() { d.shadows } else { a.shadows }),
                 warmup: a.warmup,
                 runs: a.runs,
                 out: a.out.clone(),
@@ -527,8 +535,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
             let scene = a.shadow.load(&a.scene)?;
             let opts = umbra::study::bench::BenchOptions {
                 visibility: a.visibility,
-                shadows: a.shadows,
-                shadow_options: a.shadow.options(false)?,
+                shadows: a.shadow.configure_all(a.shadows),
                 warmup: a.warmup,
                 runs: a.runs,
             };
@@ -564,13 +571,12 @@ fn run(cli: Cli) -> umbra::Result<()> {
             let methods = if a.methods.is_empty() {
                 vec![(VisibilityMethod::Scanline, ShadowMethod::None), (VisibilityMethod::ZBuffer, ShadowMethod::None)]
             } else {
-                a.methods
+                a.methods.into_iter().map(|(v, s)| (v, a.shadow.configure(s))).collect()
             };
             let opts = ScaleOptions {
                 sweep: a.sweep,
                 values: a.values,
                 methods,
-                shadow_options: a.shadow.options(false)?,
                 runs: a.runs,
                 width: a.width,
                 height: a.height,
@@ -591,7 +597,7 @@ fn run(cli: Cli) -> umbra::Result<()> {
         }
         Command::Trace(a) => {
             let scene = a.shadow.load(&a.scene)?;
-            let t = umbra::study::trace::trace(&scene, a.line, a.shadows, &a.shadow.options(true)?)?;
+            let t = umbra::study::trace::trace(&scene, a.line, &a.shadow.configure(a.shadows.clone()))?;
             if let Some(x) = a.x.filter(|&x| x >= scene.camera().width) {
                 return Err(Error::InvalidOption(format!(
                     "--x {x} is outside the image (width {})",

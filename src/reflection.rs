@@ -56,7 +56,7 @@ impl ReflectionMethod {
 impl std::str::FromStr for ReflectionMethod {
     type Err = crate::error::Error;
     fn from_str(s: &str) -> crate::error::Result<Self> {
-        crate::error::parse_named(s, &Self::ALL, Self::name, "reflection method")
+        crate::error::parse_named(s, &Self::ALL, |m| m.name(), "reflection method").copied()
     }
 }
 

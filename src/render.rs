@@ -10,13 +10,13 @@ use crate::frame::{Frame, PixelCounters};
 use crate::reflection::ReflectionMethod;
 use crate::scene::Scene;
 use crate::shading::{RunShading, Shader};
-use crate::shadow::{ShadowContext, ShadowMethod, ShadowOptions};
+use crate::shadow::{ShadowContext, ShadowDatabase, ShadowMethod};
 use crate::stats::{Counters, Stats};
 use crate::view::View;
 use crate::visibility::{FrameRuns, VisibilityMethod};
 use glam::Vec3;
 use rayon::prelude::*;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// What to render with.
@@ -24,10 +24,8 @@ use std::time::{Duration, Instant};
 pub struct RenderOptions {
     /// The hidden-surface stage.
     pub visibility: VisibilityMethod,
-    /// The shadow stage.
+    /// The shadow stage, with its settings.
     pub shadows: ShadowMethod,
-    /// Options of the shadow stages.
-    pub shadow_options: ShadowOptions,
     /// Show a progress bar on stderr when the render takes more than a second and stderr is
     /// a terminal.
     pub progress: bool,
@@ -35,6 +33,10 @@ pub struct RenderOptions {
     pub pixel_counters: bool,
     /// How mirrors are rendered.
     pub reflection: crate::reflection::ReflectionMethod,
+    /// Keep the screen outlines of the shadow stage's polygons (shadow polygons, detail
+    /// polygons) for the first light sample in [`Rendered::outlines`], to draw them over the
+    /// image.
+    pub outlines: bool,
 }
 
 impl Default for RenderOptions {
@@ -42,8 +44,8 @@ impl Default for RenderOptions {
         RenderOptions {
             visibility: VisibilityMethod::Scanline,
             shadows: ShadowMethod::DEFAULT,
-            shadow_options: ShadowOptions::default(),
             progress: false,
+            outlines: false,
             pixel_counters: false,
             reflection: crate::reflection::ReflectionMethod::default(),
         }
@@ -58,7 +60,7 @@ pub struct Rendered {
     /// Counters and times.
     pub stats: Stats,
     /// The outlines of the shadow stage's polygons for the first light sample, when
-    /// `shadow_options.keep_outlines` asked for them.
+    /// [`RenderOptions::outlines`] asked for them (empty otherwise).
     pub outlines: Vec<Vec<glam::DVec2>>,
 }
 
@@ -117,6 +119,7 @@ fn check_frame_memory(scene: &Scene, opts: &RenderOptions) -> Result<()> {
 #[derive(Default)]
 pub struct Renderer {
     pools: crate::pool::Pools,
+    awg_database: Option<Arc<Vec<ShadowDatabase>>>,
     last: Option<Rendered>,
 }
 
@@ -130,8 +133,20 @@ impl Renderer {
     /// result lives until the next call.
     pub fn render(&mut self, scene: &Scene, opts: &RenderOptions) -> Result<&Rendered> {
         let spare = self.last.take().map(|r| r.frame);
-        let out = render_with(scene, opts, &self.pools, spare)?;
+        let out = render_with(scene, opts, &self.kept(), spare)?;
         Ok(self.last.insert(out))
+    }
+
+    /// Renders Atherton-Weiler-Greenberg's shadows from `databases` (one per light, built
+    /// beforehand by [`ShadowDatabase::build`] for the scene's lights) instead of building
+    /// them in each frame: pass 1 done once for many views.
+    pub fn with_shadow_database(mut self, databases: Arc<Vec<ShadowDatabase>>) -> Renderer {
+        self.awg_database = Some(databases);
+        self
+    }
+
+    fn kept(&self) -> Kept<'_> {
+        Kept { pools: &self.pools, awg_database: self.awg_database.clone() }
     }
 
     /// The last frame rendered, to keep.
@@ -147,25 +162,28 @@ impl Renderer {
 
 /// Renders `scene` with the chosen stages (a fresh [`Renderer`]'s one frame).
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
-    render_with(scene, opts, &Default::default(), None)
+    render_with(scene, opts, &Kept { pools: &Default::default(), awg_database: None }, None)
+}
+
+/// What a renderer keeps between frames and hands to the passes.
+struct Kept<'r> {
+    pools: &'r crate::pool::Pools,
+    awg_database: Option<Arc<Vec<ShadowDatabase>>>,
 }
 
 /// The frame pass, then the reflection pass over it, taking frame-sized buffers from `pools`
 /// and `spare`.
-fn render_with(
-    scene: &Scene,
-    opts: &RenderOptions,
-    pools: &crate::pool::Pools,
-    spare: Option<Frame>,
-) -> Result<Rendered> {
-    let (mut out, runs) = frame_pass(scene, opts, pools, spare)?;
+fn render_with(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<Frame>) -> Result<Rendered> {
+    let (mut out, runs) = frame_pass(scene, opts, kept, spare)?;
     if opts.reflection != ReflectionMethod::Off {
         let t = Instant::now();
         // What a mirror shows is a frame of its own, with one level of reflection.
         let inner =
             RenderOptions { reflection: ReflectionMethod::Off, progress: false, pixel_counters: false, ..opts.clone() };
         let mirror_pass = |mirrored: &Scene| {
-            let (mut seen, _) = frame_pass(mirrored, &inner, pools, None)?;
+            // The mirrored scene has other polygons and lights: a database built beforehand
+            // for the scene does not apply.
+            let (mut seen, _) = frame_pass(mirrored, &inner, &Kept { awg_database: None, ..*kept }, None)?;
             saturate(&mut seen.frame.color);
             Ok(seen.frame)
         };
@@ -179,12 +197,8 @@ fn render_with(
 
 /// One frame, without reflections: view, visibility, shadow preparation, then the shadow
 /// walk and shading in parallel bands of lines. Returns the frame and its visible runs.
-fn frame_pass(
-    scene: &Scene,
-    opts: &RenderOptions,
-    pools: &crate::pool::Pools,
-    spare: Option<Frame>,
-) -> Result<(Rendered, FrameRuns)> {
+fn frame_pass(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<Frame>) -> Result<(Rendered, FrameRuns)> {
+    let pools = kept.pools;
     let start = Instant::now();
     // The camera is a public field: a program may have changed it since the scene was built.
     scene.camera.validate().map_err(crate::error::Error::InvalidOption)?;
@@ -214,7 +228,9 @@ fn frame_pass(
 
     let t = Instant::now();
     bar.phase(format!("shadow preparation ({})", opts.shadows.name()));
-    let ctx = ShadowContext::new(scene, &view, &runs, opts.shadow_options.clone()).with_pools(pools);
+    let ctx = ShadowContext::new(scene, &view, &runs, opts.outlines)
+        .with_pools(pools)
+        .with_awg_database(kept.awg_database.clone());
     stats.light_samples = ctx.samples.iter().map(Vec::len).sum();
     let shadows = opts.shadows.prepare(&ctx, &mut stats.shadow_counters)?;
     stats.time_ms.insert("shadow_prepare", ms(t.elapsed()));

@@ -53,15 +53,15 @@ fn a_renderer_allocates_no_frame_sized_buffer_after_its_first_frame() {
     let methods = [
         (VisibilityMethod::Scanline, ShadowMethod::None, 100),
         (VisibilityMethod::ZBuffer, ShadowMethod::None, 100),
-        (VisibilityMethod::Scanline, ShadowMethod::BouknightKelley, 20),
-        (VisibilityMethod::Scanline, ShadowMethod::Crow, 20),
-        (VisibilityMethod::ZBuffer, ShadowMethod::Williams, 20),
+        (VisibilityMethod::Scanline, ShadowMethod::BouknightKelley(Default::default()), 20),
+        (VisibilityMethod::Scanline, ShadowMethod::Crow(Default::default()), 20),
+        (VisibilityMethod::ZBuffer, ShadowMethod::Williams(Default::default()), 20),
         (VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg, 20),
-        (VisibilityMethod::ZBuffer, ShadowMethod::StencilVolume, 20),
+        (VisibilityMethod::ZBuffer, ShadowMethod::StencilVolume(Default::default()), 20),
         (VisibilityMethod::Scanline, ShadowMethod::RayCast, 20),
     ];
     for (visibility, shadows, frames) in methods {
-        let opts = RenderOptions { visibility, shadows, ..RenderOptions::default() };
+        let opts = RenderOptions { visibility, shadows: shadows.clone(), ..RenderOptions::default() };
         let mut renderer = Renderer::new();
         let first = LARGE_ALLOCATIONS.load(Ordering::Relaxed);
         renderer.render(&scene, &opts).unwrap();

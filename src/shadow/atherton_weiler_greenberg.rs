@@ -12,7 +12,7 @@
 //!    fragments are taken back onto their source polygons' planes in world space.
 //! 2. **Merge.** The lit fragments become *surface-detail polygons* of their source polygons:
 //!    the [`ShadowDatabase`]. It does not depend on the camera: build it once per light and
-//!    render it from any number of views (`ShadowOptions::awg_database`), or export it.
+//!    render it from any number of views (`Renderer::with_shadow_database`), or export it.
 //! 3. and 4. **The view pass.** Hidden-surface removal from the eye is the visibility stage;
 //!    each visible run is lit exactly where its polygon's detail polygons cover it, found by
 //!    walking the detail polygons with the shared edge and active-edge tables.
@@ -507,7 +507,7 @@ impl<'a> AthertonWeilerGreenberg<'a> {
     /// Builds the databases (or takes the ones in the options) and puts their detail polygons
     /// through the camera.
     pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Result<Self> {
-        let databases: Arc<Vec<ShadowDatabase>> = match &ctx.options.awg_database {
+        let databases: Arc<Vec<ShadowDatabase>> = match &ctx.awg_database {
             Some(db) if db.len() == ctx.scene.lights.len() => db.clone(),
             Some(_) => {
                 return Err(Error::InvalidOption("the shadow database does not match the scene's lights".into()))
@@ -523,7 +523,7 @@ impl<'a> AthertonWeilerGreenberg<'a> {
         let mut detail = Vec::new();
         for db in databases.iter() {
             for polys in &db.samples {
-                let mut overlay = Overlay::new(view.height, ctx.options.keep_outlines);
+                let mut overlay = Overlay::new(view.height, ctx.keep_outlines);
                 for d in polys.iter().filter(|d| ctx.visible[d.source as usize]) {
                     let mut rings = Vec::new();
                     for r in &d.rings {

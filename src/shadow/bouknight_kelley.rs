@@ -34,7 +34,9 @@
 
 use super::overlay::{Interval, Overlay, OverlayWalker};
 use super::projection::{bounding_rectangle, edge_on, light_side, Projector};
-use super::{Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker};
+use super::{
+    BouknightKelleyOptions, Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker,
+};
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -67,8 +69,9 @@ pub struct Pairs {
 
 impl<'a> BouknightKelley<'a> {
     /// Makes the shadow polygons of every light sample.
-    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
-        let (shadows, pairs) = ctx.all_samples().map(|(_, _, sample)| shadow_polygons(ctx, sample, counters)).unzip();
+    pub fn new(ctx: &'a ShadowContext<'a>, options: BouknightKelleyOptions, counters: &mut Counters) -> Self {
+        let (shadows, pairs) =
+            ctx.all_samples().map(|(_, _, sample)| shadow_polygons(ctx, options, sample, counters)).unzip();
         BouknightKelley { ctx, shadows, pairs }
     }
 }
@@ -79,6 +82,7 @@ impl<'a> BouknightKelley<'a> {
 /// independent, so they are worked on in parallel.
 fn shadow_polygons(
     ctx: &ShadowContext,
+    options: BouknightKelleyOptions,
     sample: LightSample,
     counters: &mut Counters,
 ) -> (Overlay, FxHashMap<u32, Pairs>) {
@@ -96,10 +100,10 @@ fn shadow_polygons(
     counters.add("pairs_with_roles", receivers.len() as u64 * casters.len() as u64);
 
     let t = Instant::now();
-    let grid = ctx.options.prefilter.then(|| SphereGrid::new(scene, sample, &casters));
+    let grid = options.prefilter.then(|| SphereGrid::new(scene, sample, &casters));
     counters.add("prefilter_grid_us", t.elapsed().as_micros() as u64);
 
-    let record = ctx.options.keep_outlines;
+    let record = ctx.keep_outlines;
     let per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>, Pairs)> = receivers
         .par_iter()
         .map_init(
@@ -146,7 +150,7 @@ fn shadow_polygons(
         )
         .collect();
 
-    let mut overlay = Overlay::new(ctx.view.height, ctx.options.keep_outlines);
+    let mut overlay = Overlay::new(ctx.view.height, ctx.keep_outlines);
     let mut total = Tally::default();
     let mut kept_pairs = FxHashMap::default();
     for (b, tally, rings, mut pairs) in per_receiver {
@@ -162,7 +166,7 @@ fn shadow_polygons(
         }
     }
     overlay.finish();
-    if ctx.options.prefilter {
+    if options.prefilter {
         counters.add("pairs_kept_by_prefilter", total.kept);
     }
     counters.add("pairs_dropped_behind", total.behind);

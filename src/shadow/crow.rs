@@ -26,7 +26,7 @@
 //! volume never counts for its own face.
 
 use super::volumes::{Adjacency, Counting, ScreenVolumes, NONE};
-use super::{CountAdd, Decision, Detail, ShadowContext, ShadowStage, ShadowWalker};
+use super::{CountAdd, Decision, Detail, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
 use crate::scan::{boundary, ActiveEdges, EdgeTable};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -47,10 +47,10 @@ pub struct Crow<'a> {
 
 impl<'a> Crow<'a> {
     /// Builds every light sample's shadow polygons and their edge tables.
-    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
-        let counting = ctx.options.crow_count;
+    pub fn new(ctx: &'a ShadowContext<'a>, options: VolumeOptions, counters: &mut Counters) -> Self {
+        let counting = options.counting;
         let view = ctx.view;
-        let adjacency = Adjacency::new(ctx.scene, ctx.options.silhouettes);
+        let adjacency = Adjacency::new(ctx.scene, options.silhouettes);
         let samples = ctx
             .all_samples()
             .map(|(_, _, sample)| {
@@ -95,7 +95,7 @@ impl ShadowStage for Crow<'_> {
     }
 
     fn outlines(&self) -> Vec<Vec<DVec2>> {
-        if !self.ctx.options.keep_outlines {
+        if !self.ctx.keep_outlines {
             return Vec::new();
         }
         self.samples.first().map_or_else(Vec::new, |s| s.volumes.rings.clone())
@@ -202,7 +202,7 @@ impl ShadowWalker for Walker<'_> {
                 continue;
             }
             let p = &polys[t as usize];
-            let (adds, record) = (&mut self.last_adds, self.stage.ctx.options.keep_outlines);
+            let (adds, record) = (&mut self.last_adds, self.stage.ctx.keep_outlines);
             // What polygon p adds to the count at pixel x (see `count_at`).
             let counts = |x: u32| {
                 let xc = x as f64 + 0.5;

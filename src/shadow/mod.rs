@@ -33,38 +33,44 @@ use crate::stats::Counters;
 use crate::view::View;
 use crate::visibility::{FrameRuns, Run};
 
-/// Options of the shadow stages (each stage reads its own).
-#[derive(Debug, Clone, PartialEq)]
-pub struct ShadowOptions {
-    /// Bouknight-Kelley: use the sphere prefilter (default true).
+/// Bouknight-Kelley's settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct BouknightKelleyOptions {
+    /// Use the sphere prefilter (default true): pairs whose extents on a sphere around the
+    /// light do not overlap are dropped before any projection.
     pub prefilter: bool,
-    /// Crow: how the shadow volumes are counted along the line of sight (default z-pass).
-    pub crow_count: volumes::Counting,
-    /// Crow and stencil volumes: merge the sides that neighbouring polygons share, so that
-    /// only silhouette and boundary edges keep sides (default true); `false` gives every
-    /// polygon its own volume, to measure the saving.
-    pub silhouettes: bool,
-    /// Williams' shadow maps: resolution, bias, filter, culling.
-    pub williams: WilliamsOptions,
-    /// Atherton-Weiler-Greenberg: a shadow database built beforehand (one per light), to
-    /// render many views of one database; `None` builds it.
-    pub awg_database: Option<std::sync::Arc<Vec<ShadowDatabase>>>,
-    /// Keep the screen outlines of the stage's polygons (shadow polygons, detail polygons)
-    /// for drawing them over the image, and what traces show of them (Bouknight-Kelley:
-    /// what became of each receiver's pairs).
-    pub keep_outlines: bool,
 }
 
-impl Default for ShadowOptions {
+impl BouknightKelleyOptions {
+    /// The paper's method, with its prefilter.
+    pub const DEFAULT: BouknightKelleyOptions = BouknightKelleyOptions { prefilter: true };
+}
+
+impl Default for BouknightKelleyOptions {
     fn default() -> Self {
-        ShadowOptions {
-            prefilter: true,
-            crow_count: volumes::Counting::ZPass,
-            silhouettes: true,
-            williams: WilliamsOptions::default(),
-            awg_database: None,
-            keep_outlines: false,
-        }
+        Self::DEFAULT
+    }
+}
+
+/// The settings of shadow volumes, counted per span (Crow) or per pixel (stencil).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct VolumeOptions {
+    /// How the volumes are counted along the line of sight (default z-pass).
+    pub counting: volumes::Counting,
+    /// Merge the sides that neighbouring polygons share, so that only silhouette and
+    /// boundary edges keep sides (default true); `false` gives every polygon its own volume,
+    /// to measure the saving.
+    pub silhouettes: bool,
+}
+
+impl VolumeOptions {
+    /// Z-pass with the eye's own count, on silhouette edges.
+    pub const DEFAULT: VolumeOptions = VolumeOptions { counting: volumes::Counting::ZPass, silhouettes: true };
+}
+
+impl Default for VolumeOptions {
+    fn default() -> Self {
+        Self::DEFAULT
     }
 }
 
@@ -79,8 +85,13 @@ pub struct ShadowContext<'a> {
     /// `visible[i]`: whether scene polygon `i` is seen at some pixel (the receivers that
     /// matter).
     pub visible: Vec<bool>,
-    /// Stage options.
-    pub options: ShadowOptions,
+    /// Keep the screen outlines of the stage's polygons (shadow polygons, detail polygons)
+    /// for drawing them over the image, and what traces show of them (Bouknight-Kelley:
+    /// what became of each receiver's pairs).
+    pub keep_outlines: bool,
+    /// Atherton-Weiler-Greenberg's shadow databases (one per light), built beforehand to
+    /// render many views of them; `None` builds them.
+    pub(crate) awg_database: Option<std::sync::Arc<Vec<ShadowDatabase>>>,
     /// Each light's samples (`samples[light][sample]`).
     pub samples: Vec<Vec<LightSample>>,
     /// The scene's size (diagonal of its bounds), for tolerances.
@@ -91,11 +102,17 @@ pub struct ShadowContext<'a> {
 
 impl<'a> ShadowContext<'a> {
     /// The context for rendering `scene` from `view`, whose visible runs are `runs`.
-    pub fn new(scene: &'a Scene, view: &'a View, runs: &'a FrameRuns, options: ShadowOptions) -> Self {
+    pub fn new(scene: &'a Scene, view: &'a View, runs: &'a FrameRuns, keep_outlines: bool) -> Self {
         let samples = scene.lights.iter().map(|l| l.samples()).collect();
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
         let visible = runs.visible(scene.polygons.len());
-        ShadowContext { scene, view, runs, visible, options, samples, extent, pools: Default::default() }
+        let pools = Default::default();
+        ShadowContext { scene, view, runs, visible, keep_outlines, awg_database: None, samples, extent, pools }
+    }
+
+    /// The same context, with Atherton-Weiler-Greenberg's databases built beforehand.
+    pub(crate) fn with_awg_database(self, db: Option<std::sync::Arc<Vec<ShadowDatabase>>>) -> Self {
+        ShadowContext { awg_database: db, ..self }
     }
 
     /// The same context, taking its frame-sized buffers from `pools` (a renderer's).
@@ -291,23 +308,25 @@ pub struct CountAdd {
     pub near_cap: bool,
 }
 
-/// The shadow methods, chosen by name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+/// The shadow methods, each with its own settings. Chosen by name on the command line
+/// (`"crow".parse()` gives Crow with its defaults).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum ShadowMethod {
     /// No shadows: every sample reaches every point on its seen side.
     None,
     /// One shadow ray per pixel and light sample (the exact reference).
     RayCast,
     /// Appel / Bouknight-Kelley projected shadow polygons, scan segment by scan segment.
-    BouknightKelley,
+    BouknightKelley(BouknightKelleyOptions),
     /// Crow's shadow volumes counted per span.
-    Crow,
+    Crow(VolumeOptions),
     /// Atherton-Weiler-Greenberg: hidden-surface removal from the light, lit detail polygons.
     AthertonWeilerGreenberg,
     /// Williams' two-pass z-buffer shadow maps (approximate).
-    Williams,
+    Williams(WilliamsOptions),
     /// Shadow volumes counted per pixel in a stencil buffer.
-    StencilVolume,
+    StencilVolume(VolumeOptions),
     /// Blinn's shadows projected onto marked receiver planes (approximate).
     Planar,
 }
@@ -315,50 +334,58 @@ pub enum ShadowMethod {
 impl ShadowMethod {
     /// The engine's recommended exact method (the default of `--shadows`): Bouknight-Kelley,
     /// exact, the fastest exact stage on the benchmark scenes, and the oldest.
-    pub const DEFAULT: ShadowMethod = ShadowMethod::BouknightKelley;
+    pub const DEFAULT: ShadowMethod = ShadowMethod::BouknightKelley(BouknightKelleyOptions::DEFAULT);
 
-    /// Every method.
+    /// Every method, with its default settings.
     pub const ALL: [ShadowMethod; 8] = [
         ShadowMethod::None,
-        ShadowMethod::BouknightKelley,
+        ShadowMethod::BouknightKelley(BouknightKelleyOptions::DEFAULT),
         ShadowMethod::AthertonWeilerGreenberg,
-        ShadowMethod::Crow,
-        ShadowMethod::Williams,
-        ShadowMethod::StencilVolume,
+        ShadowMethod::Crow(VolumeOptions::DEFAULT),
+        ShadowMethod::Williams(WilliamsOptions::DEFAULT),
+        ShadowMethod::StencilVolume(VolumeOptions::DEFAULT),
         ShadowMethod::Planar,
         ShadowMethod::RayCast,
     ];
 
     /// The method's name on the command line.
-    pub fn name(self) -> &'static str {
+    pub fn name(&self) -> &'static str {
         match self {
             ShadowMethod::None => "none",
             ShadowMethod::RayCast => "ray-cast",
-            ShadowMethod::BouknightKelley => "bouknight-kelley",
-            ShadowMethod::Crow => "crow",
+            ShadowMethod::BouknightKelley(_) => "bouknight-kelley",
+            ShadowMethod::Crow(_) => "crow",
             ShadowMethod::AthertonWeilerGreenberg => "atherton-weiler-greenberg",
-            ShadowMethod::Williams => "williams",
-            ShadowMethod::StencilVolume => "stencil-volume",
+            ShadowMethod::Williams(_) => "williams",
+            ShadowMethod::StencilVolume(_) => "stencil-volume",
             ShadowMethod::Planar => "planar",
         }
     }
 
-    /// Whether the method gives the exact answer of section 3 (with its exact options:
-    /// Crow and the stencil volumes except with naive z-pass).
-    pub fn is_exact(self) -> bool {
-        !matches!(self, ShadowMethod::None | ShadowMethod::Williams | ShadowMethod::Planar)
+    /// Whether the method gives the exact answer of `docs/scene-format.md` §3: every method
+    /// but the approximate ones, and shadow volumes counted by the naive z-pass.
+    pub fn is_exact(&self) -> bool {
+        match self {
+            ShadowMethod::None | ShadowMethod::Williams(_) | ShadowMethod::Planar => false,
+            ShadowMethod::Crow(v) | ShadowMethod::StencilVolume(v) => v.counting != volumes::Counting::NaiveZPass,
+            _ => true,
+        }
     }
 
     /// Prepares the stage.
-    pub fn prepare<'a>(self, ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Result<Box<dyn ShadowStage + 'a>> {
+    pub(crate) fn prepare<'a>(
+        &self,
+        ctx: &'a ShadowContext<'a>,
+        counters: &mut Counters,
+    ) -> Result<Box<dyn ShadowStage + 'a>> {
         Ok(match self {
             ShadowMethod::None => Box::new(NoShadows),
             ShadowMethod::RayCast => Box::new(RayCastShadows::new(ctx, counters)),
-            ShadowMethod::BouknightKelley => Box::new(BouknightKelley::new(ctx, counters)),
-            ShadowMethod::Crow => Box::new(Crow::new(ctx, counters)),
+            ShadowMethod::BouknightKelley(o) => Box::new(BouknightKelley::new(ctx, *o, counters)),
+            ShadowMethod::Crow(o) => Box::new(Crow::new(ctx, *o, counters)),
             ShadowMethod::AthertonWeilerGreenberg => Box::new(AthertonWeilerGreenberg::new(ctx, counters)?),
-            ShadowMethod::Williams => Box::new(Williams::new(ctx, counters)?),
-            ShadowMethod::StencilVolume => Box::new(StencilVolume::new(ctx, counters)?),
+            ShadowMethod::Williams(o) => Box::new(Williams::new(ctx, o, counters)?),
+            ShadowMethod::StencilVolume(o) => Box::new(StencilVolume::new(ctx, *o, counters)?),
             ShadowMethod::Planar => Box::new(Planar::new(ctx, counters)?),
         })
     }
@@ -367,7 +394,7 @@ impl ShadowMethod {
 impl std::str::FromStr for ShadowMethod {
     type Err = crate::error::Error;
     fn from_str(s: &str) -> crate::error::Result<Self> {
-        crate::error::parse_named(s, &Self::ALL, Self::name, "shadow method")
+        crate::error::parse_named(s, &Self::ALL, |m| m.name(), "shadow method").cloned()
     }
 }
 

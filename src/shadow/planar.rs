@@ -5,7 +5,7 @@
 //!
 //! - A point light at L, plane `A x + B y + C z + D = 0` written with the light at the origin
 //!   (the "Rendering 6: Shadow" notes): `M = [[−D,0,0,0],[0,−D,0,0],[0,0,−D,0],[A,B,C,0]]`, applied as
-//!   `T(L) · M · T(−L)`. (Seed 004's `M_per`, for the plane `z = 0` and the centre of
+//!   `T(L) · M · T(−L)`. (The "Árnyékolás" notes' `M_per`, for the plane `z = 0` and the centre of
 //!   projection at `(0, 0, −d)`, is the same matrix up to scale.)
 //! - A directional light along `(x_l, y_l, z_l)` and the plane `z = 0` (the "Árnyékolás" notes):
 //!   `M_par = [[1,0,−x_l/z_l,0],[0,1,−y_l/z_l,0],[0,0,0,0],[0,0,0,1]]`, applied in a frame
@@ -85,7 +85,7 @@ impl<'a> Planar<'a> {
         let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
         let (mut clipped, mut projected) = (Vec::new(), Vec::new());
         for (_, _, sample) in ctx.all_samples() {
-            let mut overlay = Overlay::new(ctx.view.height, ctx.options.keep_outlines);
+            let mut overlay = Overlay::new(ctx.view.height, ctx.keep_outlines);
             for &r in receivers.iter().filter(|&&r| ctx.visible[r]) {
                 let plane = scene.polygons[r].plane;
                 let m = projection_matrix(&plane, sample);
@@ -141,7 +141,7 @@ mod tests {
         let p = DVec3::new(0.1, 1.0, 0.7);
         let h = m * p.extend(1.0);
         let q = h.truncate() / h.w;
-        // Seed 003's formula: Q = L − (P − L)(N·L + d)/(N·(P − L)).
+        // The "Special Effect" notes' formula: Q = L − (P − L)(N·L + d)/(N·(P − L)).
         let want = l - (p - l) * (plane.distance(l) / plane.n.dot(p - l));
         assert!((q - want).length() < 1e-12, "{q} vs {want}");
         assert!(plane.distance(q).abs() < 1e-12);

@@ -6,7 +6,7 @@
 //! shadow where its count is above zero.
 
 use super::volumes::{Adjacency, ScreenVolumes};
-use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
 use crate::scan::{for_each_span, EdgeTable};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -22,7 +22,11 @@ pub struct StencilVolume<'a> {
 
 impl<'a> StencilVolume<'a> {
     /// Rasterises every light sample's shadow polygons into a stencil count.
-    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> crate::error::Result<Self> {
+    pub fn new(
+        ctx: &'a ShadowContext<'a>,
+        options: VolumeOptions,
+        counters: &mut Counters,
+    ) -> crate::error::Result<Self> {
         let view = ctx.view;
         let (w, h) = (view.width as usize, view.height);
         let pixels = w as u64 * h as u64;
@@ -39,8 +43,8 @@ impl<'a> StencilVolume<'a> {
             }
         }
         let planes: Vec<Option<DepthPlane>> = scene.polygons.iter().map(|p| view.depth_plane(&p.plane)).collect();
-        let adjacency = Adjacency::new(scene, ctx.options.silhouettes);
-        let counting = ctx.options.crow_count;
+        let adjacency = Adjacency::new(scene, options.silhouettes);
+        let counting = options.counting;
         let band = crate::scan::band_height(h);
         let mut writes = 0u64;
         let lit = ctx

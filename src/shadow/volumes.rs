@@ -52,7 +52,7 @@ use crate::view::DepthPlane;
 use glam::{DVec2, DVec3, DVec4};
 
 /// How a count is taken along the line of sight.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Counting {
     /// From the eye to the visible point, starting from the eye's own count (near caps).
     #[default]
@@ -81,7 +81,7 @@ impl Counting {
 impl std::str::FromStr for Counting {
     type Err = crate::error::Error;
     fn from_str(s: &str) -> crate::error::Result<Self> {
-        crate::error::parse_named(s, &Self::ALL, Self::name, "count")
+        crate::error::parse_named(s, &Self::ALL, |m| m.name(), "count").copied()
     }
 }
 

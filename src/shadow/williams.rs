@@ -44,7 +44,7 @@ pub enum ShadowFilter {
     Nearest,
     /// Percentage-closer filtering over N×N texels (N odd).
     Pcf(u32),
-    /// Seed 002: N×N PCF into a screen buffer, then the 15-tap separable Gaussian blur.
+    /// Shastry's "Soft-Edged Shadows": N×N PCF into a screen buffer, then the 15-tap separable Gaussian blur.
     SoftEdge(u32),
 }
 
@@ -77,17 +77,23 @@ pub struct WilliamsOptions {
 
 impl Default for WilliamsOptions {
     fn default() -> Self {
-        WilliamsOptions {
-            map_size: 2048,
-            bias: None,
-            slope_bias: 0.0,
-            normal_offset: 2.0,
-            receiver_plane: false,
-            filter: ShadowFilter::Pcf(3),
-            cull_front: false,
-            fit_to_view: true,
-        }
+        Self::DEFAULT
     }
+}
+
+impl WilliamsOptions {
+    /// The defaults: a 2048² map, a bias of one texel, a normal offset of two texels, 3x3 PCF,
+    /// maps fitted to the view.
+    pub const DEFAULT: WilliamsOptions = WilliamsOptions {
+        map_size: 2048,
+        bias: None,
+        slope_bias: 0.0,
+        normal_offset: 2.0,
+        receiver_plane: false,
+        filter: ShadowFilter::Pcf(3),
+        cull_front: false,
+        fit_to_view: true,
+    };
 }
 
 impl WilliamsOptions {
@@ -722,8 +728,8 @@ pub struct Williams<'a> {
 
 impl<'a> Williams<'a> {
     /// Pass 1 for every light sample (and, for the soft-edge filter, the screen buffers).
-    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Result<Self> {
-        let options = ctx.options.williams.clone();
+    pub fn new(ctx: &'a ShadowContext<'a>, options: &WilliamsOptions, counters: &mut Counters) -> Result<Self> {
+        let options = options.clone();
         options.check()?;
         Self::check_memory(ctx, &options)?;
         let bias = options.bias.unwrap_or(0.0);
@@ -807,7 +813,7 @@ impl<'a> Williams<'a> {
         (h0 * flip, step * flip, bias)
     }
 
-    /// Seed 002: the N×N PCF term of every visible pixel in a screen-sized buffer (1 where
+    /// Shastry's "Soft-Edged Shadows": the N×N PCF term of every visible pixel in a screen-sized buffer (1 where
     /// nothing is seen, or the sample is on the polygon's unseen side), blurred horizontally
     /// then vertically with the seed's 15 taps.
     fn soft_edge_buffer(&self, light: usize, s: usize) -> Vec<f32> {
@@ -854,7 +860,7 @@ fn blur(src: &[f32], w: usize, h: usize, taps: &[(i64, f32)], along_rows: bool) 
     out
 }
 
-/// Seed 002's 15 taps (offset in pixels, weight): the centre weighted `G(0, ρ = 2)`, then for
+/// Shastry's 15 taps (offset in pixels, weight): the centre weighted `G(0, ρ = 2)`, then for
 /// i = 1, 3, …, 13 the offsets `+i` and `−i` weighted `2 G(i, 3)` and `2 G(i + 1, 3)`, with
 /// `G(x, ρ) = exp(−x²/2ρ²)/√(2πρ²)`. Reproduced as published: the taps skip even offsets,
 /// the two sides are weighted unequally, and the weights sum to about 1.07 (the blurred term

@@ -7,7 +7,7 @@
 use crate::error::{Error, Result};
 use crate::render::{RenderOptions, Rendered, Renderer};
 use crate::scene::Scene;
-use crate::shadow::{ShadowMethod, ShadowOptions};
+use crate::shadow::ShadowMethod;
 use crate::visibility::VisibilityMethod;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -18,10 +18,8 @@ use std::time::Instant;
 pub struct BenchOptions {
     /// The visibility stages (one row per visibility × shadow pair).
     pub visibility: Vec<VisibilityMethod>,
-    /// The shadow stages.
+    /// The shadow stages, with their settings.
     pub shadows: Vec<ShadowMethod>,
-    /// Options of the shadow stages.
-    pub shadow_options: ShadowOptions,
     /// Untimed frames first.
     pub warmup: usize,
     /// Timed frames.
@@ -110,14 +108,9 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
     }
     let mut rows = Vec::new();
     for &v in &o.visibility {
-        for &s in &o.shadows {
+        for s in &o.shadows {
             progress(&format!("{v} + {s}"));
-            let opts = RenderOptions {
-                visibility: v,
-                shadows: s,
-                shadow_options: o.shadow_options.clone(),
-                ..RenderOptions::default()
-            };
+            let opts = RenderOptions { visibility: v, shadows: s.clone(), ..RenderOptions::default() };
             let m = measure(scene, &opts, o.warmup, o.runs)?;
             rows.push(BenchRow {
                 visibility: v.name().into(),

@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::frame::Frame;
 use crate::render::{render, RenderOptions};
 use crate::scene::Scene;
-use crate::shadow::{ShadowMethod, ShadowOptions};
+use crate::shadow::ShadowMethod;
 use crate::study::bench::{measure, Spread};
 use crate::study::escape;
 use crate::visibility::VisibilityMethod;
@@ -27,8 +27,6 @@ pub struct CompareOptions {
     pub visibility: Vec<VisibilityMethod>,
     /// Shadow stages.
     pub shadows: Vec<ShadowMethod>,
-    /// Options every shadow stage gets.
-    pub shadow_options: ShadowOptions,
     /// Untimed renders per method before the timed ones.
     pub warmup: usize,
     /// Timed runs per method (the median, least and greatest are reported).
@@ -44,7 +42,6 @@ impl Default for CompareOptions {
         CompareOptions {
             visibility: VisibilityMethod::ALL.to_vec(),
             shadows: ShadowMethod::ALL.to_vec(),
-            shadow_options: ShadowOptions::default(),
             warmup: 1,
             runs: 3,
             out: PathBuf::from("compare"),
@@ -148,7 +145,6 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
     let reference_opts = RenderOptions {
         visibility: VisibilityMethod::RayCast,
         shadows: ShadowMethod::RayCast,
-        shadow_options: opts.shadow_options.clone(),
         ..RenderOptions::default()
     };
     let reference = render(scene, &reference_opts)?.frame;
@@ -157,15 +153,10 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
     let mut bar = crate::progress::Bar::new(opts.progress, total, "{msg:32} {bar:40} {pos}/{len} renders {elapsed}");
     let mut results = Vec::new();
     for &v in &opts.visibility {
-        for &s in &opts.shadows {
+        for s in &opts.shadows {
             bar.set_message(format!("{v} + {s}"));
             let id = format!("{v}-{s}");
-            let ropts = RenderOptions {
-                visibility: v,
-                shadows: s,
-                shadow_options: opts.shadow_options.clone(),
-                ..RenderOptions::default()
-            };
+            let ropts = RenderOptions { visibility: v, shadows: s.clone(), ..RenderOptions::default() };
             let (status, measured) = match measure(scene, &ropts, opts.warmup, opts.runs) {
                 Ok(m) => ("ok".to_string(), Some(m)),
                 Err(Error::NotApplicable(why)) => (format!("not applicable: {why}"), None),
@@ -220,8 +211,8 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
     bar.finish();
     let report = Report {
         about: super::About::now(format!(
-            "warmup {}, runs {}, shadow options {:?}",
-            opts.warmup, opts.runs, opts.shadow_options
+            "warmup {}, runs {}, shadow stages {:?}",
+            opts.warmup, opts.runs, opts.shadows
         )),
         scene: name.into(),
         width: scene.camera.width,

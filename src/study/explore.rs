@@ -24,7 +24,7 @@ use crate::error::{Error, Result};
 use crate::reference::{Reference, Tie};
 use crate::render::{render, RenderOptions, Rendered};
 use crate::scene::{LightKind, Scene};
-use crate::shadow::{ShadowMethod, ShadowOptions};
+use crate::shadow::ShadowMethod;
 use glam::DVec3;
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -195,18 +195,14 @@ impl Explorer {
             return Ok(s.clone());
         }
         let scene = self.scene_for(r)?;
-        let opts = |shadows| RenderOptions {
-            shadows,
-            shadow_options: ShadowOptions { keep_outlines: true, ..ShadowOptions::default() },
-            ..RenderOptions::default()
-        };
-        let got = render(&scene, &opts(r.shadows))?;
+        let opts = |shadows| RenderOptions { shadows, outlines: true, ..RenderOptions::default() };
+        let got = render(&scene, &opts(r.shadows.clone()))?;
         let reference = render(&scene, &opts(ShadowMethod::RayCast))?;
         let png = crate::frame::encode_png(got.frame.color_image(None).into())?;
         let mut summary = summary(&scene, r, &got, &reference);
         // Only the shadow map has pictures; other stages are not prepared a second time.
         let made = match r.shadows {
-            ShadowMethod::Williams => super::trace::pictures(&scene, r.shadows, &traced())?,
+            ShadowMethod::Williams(_) => super::trace::pictures(&scene, &r.shadows)?,
             _ => Vec::new(),
         };
         let pictures = made.iter().map(|p| crate::frame::encode_png(p.image.clone().into())).collect::<Result<_>>()?;
@@ -247,14 +243,8 @@ impl Explorer {
         let line: u32 =
             line.parse().map_err(|_| Error::InvalidOption(format!("line '{line}' is not a line number")))?;
         let scene = self.scene_for(&r)?;
-        trace(&scene, line, r.shadows, &traced())
+        trace(&scene, line, &r.shadows)
     }
-}
-
-/// The stages' options for a trace: the defaults, keeping what the stages can tell about
-/// their polygons (Bouknight-Kelley's pairs per receiver, the outlines).
-fn traced() -> ShadowOptions {
-    ShadowOptions { keep_outlines: true, ..ShadowOptions::default() }
 }
 
 /// What the page shows of a render: size, times, counters, the stage's polygons on screen
@@ -409,8 +399,8 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
     let (width, height) = (side("width", &width.to_string())?, side("height", &height.to_string())?);
     let mut frames = serde_json::Map::new();
     let mut watkins = String::new();
-    for &shadows in stages {
-        let r = Request { shadows, width, height, light: None };
+    for shadows in stages {
+        let r = Request { shadows: shadows.clone(), width, height, light: None };
         let shown = match explorer.show(&r) {
             Err(Error::NotApplicable(_)) => continue,
             other => other?,
@@ -423,7 +413,7 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
         // The visibility part of a line is the same for every stage: written once.
         let first = watkins.is_empty();
         let mut decisions = String::new();
-        trace_lines(&explorer.scene_for(&r)?, 0..height, shadows, &traced(), |mut t| {
+        trace_lines(&explorer.scene_for(&r)?, 0..height, shadows, |mut t| {
             // Bouknight-Kelley's pairs per receiver repeat on every run of the receiver: the
             // static page leaves them out (the live page shows them).
             let mut d = serde_json::to_value(&t.decisions).map_err(|e| Error::Internal(e.to_string()))?;

@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::generate;
 use crate::render::RenderOptions;
 use crate::scene::Scene;
-use crate::shadow::{ShadowMethod, ShadowOptions};
+use crate::shadow::ShadowMethod;
 use crate::study::bench::{measure, Spread};
 use crate::visibility::VisibilityMethod;
 #[cfg(feature = "plots")]
@@ -89,7 +89,7 @@ impl std::str::FromStr for Sweep {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
         let all: Vec<Sweep> = Self::NAMES.iter().map(|n| n.1).collect();
-        crate::error::parse_named(s, &all, Sweep::name, "sweep")
+        crate::error::parse_named(s, &all, |m| m.name(), "sweep").copied()
     }
 }
 
@@ -102,8 +102,6 @@ pub struct ScaleOptions {
     pub values: Vec<f64>,
     /// The methods: (visibility, shadows).
     pub methods: Vec<(VisibilityMethod, ShadowMethod)>,
-    /// Options every shadow stage gets.
-    pub shadow_options: ShadowOptions,
     /// Timed runs per point (median reported).
     pub runs: usize,
     /// Image size (except for the resolution sweep).
@@ -151,13 +149,8 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     let mut known = std::collections::BTreeSet::new();
     for (i, &value) in o.values.iter().enumerate() {
         let scene = o.sweep.scene(value, o)?;
-        for &(v, s) in &o.methods {
-            let opts = RenderOptions {
-                visibility: v,
-                shadows: s,
-                shadow_options: o.shadow_options.clone(),
-                ..RenderOptions::default()
-            };
+        for (v, s) in &o.methods {
+            let opts = RenderOptions { visibility: *v, shadows: s.clone(), ..RenderOptions::default() };
             let m = measure(&scene, &opts, 1, o.runs)?;
             let r = &m.last;
             let counters = if kind == "shadow" { &r.stats.shadow_counters } else { &r.stats.visibility_counters };
@@ -192,13 +185,13 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         );
     }
     let about = super::About::now(format!(
-        "sweep {} over {:?}, {} timed run(s) after one warm-up, {}x{}, shadow options {:?}",
+        "sweep {} over {:?}, {} timed run(s) after one warm-up, {}x{}, methods {:?}",
         o.sweep.name(),
         o.values,
         o.runs.max(1),
         o.width,
         o.height,
-        o.shadow_options
+        o.methods
     ));
     let json = serde_json::json!({ "about": about, "counter": o.counter, "points": points });
     let path = o.out.join("scale.json");
@@ -377,7 +370,7 @@ impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
             .y_desc(self.label)
             .draw()
             .err_text()?;
-        for (i, &(v, s)) in self.o.methods.iter().enumerate() {
+        for (i, (v, s)) in self.o.methods.iter().enumerate() {
             let colour = Palette99::pick(i).to_rgba();
             let mine: Vec<&Point> =
                 positive.iter().copied().filter(|p| p.visibility == v.name() && p.shadows == s.name()).collect();
@@ -397,7 +390,7 @@ impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
 
     /// The methods' colours beside the plot.
     fn legend<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
-        for (i, &(v, s)) in self.o.methods.iter().enumerate() {
+        for (i, (v, s)) in self.o.methods.iter().enumerate() {
             let colour = Palette99::pick(i).to_rgba();
             let row = 40 + 22 * i as i32;
             area.draw(&PathElement::new(vec![(8, row), (30, row)], colour.stroke_width(2))).err_text()?;

@@ -6,7 +6,7 @@
 use crate::error::{Error, Result};
 use crate::scan::ActiveEdges;
 use crate::scene::Scene;
-use crate::shadow::{Decision, Picture, ShadowContext, ShadowMethod, ShadowOptions, ShadowStage, ShadowWalker};
+use crate::shadow::{Decision, Picture, ShadowContext, ShadowMethod, ShadowStage, ShadowWalker};
 use crate::stats::Counters;
 use crate::view::{ScreenPolygon, View};
 use crate::visibility::{resolve, Run, ScanlineVisibility, SpanRecord, Visibility};
@@ -73,10 +73,11 @@ pub struct LineTrace {
     pub decisions: Vec<ShadowTrace>,
 }
 
-/// Traces line `line` of `scene` with scanline visibility and the shadow stage `shadows`.
-pub fn trace(scene: &Scene, line: u32, shadows: ShadowMethod, options: &ShadowOptions) -> Result<LineTrace> {
+/// Traces line `line` of `scene` with scanline visibility and the shadow stage `shadows`
+/// (which keeps its polygons' outlines and what became of them, for the trace to show).
+pub fn trace(scene: &Scene, line: u32, shadows: &ShadowMethod) -> Result<LineTrace> {
     let mut out = None;
-    trace_lines(scene, line..line + 1, shadows, options, |t| {
+    trace_lines(scene, line..line + 1, shadows, |t| {
         out = Some(t);
         Ok(())
     })?;
@@ -88,8 +89,7 @@ pub fn trace(scene: &Scene, line: u32, shadows: ShadowMethod, options: &ShadowOp
 pub fn trace_lines(
     scene: &Scene,
     lines: Range<u32>,
-    shadows: ShadowMethod,
-    options: &ShadowOptions,
+    shadows: &ShadowMethod,
     mut emit: impl FnMut(LineTrace) -> Result<()>,
 ) -> Result<()> {
     let view = View::new(&scene.camera);
@@ -100,7 +100,7 @@ pub fn trace_lines(
             view.height
         )));
     }
-    with_stage(scene, &view, shadows, options, |screen, vis, ctx, stage| {
+    with_stage(scene, &view, shadows, |screen, vis, ctx, stage| {
         let edge = |e: (u32, u32, u32, f64, f64, f64)| {
             let poly = screen[e.0 as usize].poly;
             EdgeTrace {
@@ -140,9 +140,9 @@ pub fn trace_lines(
 }
 
 /// The pictures the shadow stage `shadows` builds for `scene` (Williams: its depth maps).
-pub fn pictures(scene: &Scene, shadows: ShadowMethod, options: &ShadowOptions) -> Result<Vec<Picture>> {
+pub fn pictures(scene: &Scene, shadows: &ShadowMethod) -> Result<Vec<Picture>> {
     let view = View::new(&scene.camera);
-    with_stage(scene, &view, shadows, options, |_, _, _, stage| Ok(stage.pictures()))
+    with_stage(scene, &view, shadows, |_, _, _, stage| Ok(stage.pictures()))
 }
 
 /// Prepares what a render prepares before its walk (the screen polygons, Watkins'
@@ -150,15 +150,14 @@ pub fn pictures(scene: &Scene, shadows: ShadowMethod, options: &ShadowOptions) -
 fn with_stage<T>(
     scene: &Scene,
     view: &View,
-    shadows: ShadowMethod,
-    options: &ShadowOptions,
+    shadows: &ShadowMethod,
     f: impl FnOnce(&[ScreenPolygon], &ScanlineVisibility, &ShadowContext, &dyn ShadowStage) -> Result<T>,
 ) -> Result<T> {
     let screen = view.screen_polygons(scene);
     let mut counters = Counters::default();
     let vis = ScanlineVisibility::new(scene, &screen, view, &mut counters);
     let frame_runs = resolve(&vis as &dyn Visibility, view.height, &mut counters);
-    let ctx = ShadowContext::new(scene, view, &frame_runs, options.clone());
+    let ctx = ShadowContext::new(scene, view, &frame_runs, true);
     let stage = shadows.prepare(&ctx, &mut counters)?;
     f(&screen, &vis, &ctx, stage.as_ref())
 }

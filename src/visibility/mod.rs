@@ -84,7 +84,7 @@ impl VisibilityMethod {
 impl std::str::FromStr for VisibilityMethod {
     type Err = crate::error::Error;
     fn from_str(s: &str) -> crate::error::Result<Self> {
-        crate::error::parse_named(s, &Self::ALL, Self::name, "visibility method")
+        crate::error::parse_named(s, &Self::ALL, |m| m.name(), "visibility method").copied()
     }
 }
 

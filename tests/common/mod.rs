@@ -3,7 +3,6 @@
 
 use std::path::PathBuf;
 use umbra::reference::{Reference, Tie};
-use umbra::shadow::ShadowOptions;
 use umbra::{render, Frame, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 /// Every scene file in `scenes/`.
@@ -39,43 +38,26 @@ pub fn load_scaled(path: &PathBuf, max_width: u32) -> Scene {
 }
 
 pub fn frame(scene: &Scene, visibility: VisibilityMethod, shadows: ShadowMethod) -> Frame {
-    frame_with(scene, visibility, shadows, ShadowOptions::default())
-}
-
-pub fn frame_with(
-    scene: &Scene,
-    visibility: VisibilityMethod,
-    shadows: ShadowMethod,
-    shadow_options: ShadowOptions,
-) -> Frame {
-    let opts = RenderOptions { visibility, shadows, shadow_options, ..Default::default() };
+    let opts = RenderOptions { visibility, shadows, ..Default::default() };
     render(scene, &opts).unwrap_or_else(|e| panic!("{e}")).frame
 }
 
-/// The exact scanline-family stages, with the options that make them exact.
-pub fn exact_stages() -> Vec<(String, ShadowMethod, ShadowOptions)> {
+/// The exact scanline-family stages, with the settings that make them exact.
+pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
     use umbra::shadow::volumes::Counting;
-    let d = ShadowOptions::default;
+    use umbra::shadow::{BouknightKelleyOptions, VolumeOptions};
+    let volumes = |counting| VolumeOptions { counting, ..VolumeOptions::default() };
     vec![
-        ("bouknight-kelley".into(), ShadowMethod::BouknightKelley, d()),
+        ("bouknight-kelley".into(), ShadowMethod::BouknightKelley(BouknightKelleyOptions::default())),
         (
             "bouknight-kelley --no-prefilter".into(),
-            ShadowMethod::BouknightKelley,
-            ShadowOptions { prefilter: false, ..d() },
+            ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false }),
         ),
-        ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg, d()),
-        ("crow zpass".into(), ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZPass, ..d() }),
-        ("crow zfail".into(), ShadowMethod::Crow, ShadowOptions { crow_count: Counting::ZFail, ..d() }),
-        (
-            "stencil-volume zpass".into(),
-            ShadowMethod::StencilVolume,
-            ShadowOptions { crow_count: Counting::ZPass, ..d() },
-        ),
-        (
-            "stencil-volume zfail".into(),
-            ShadowMethod::StencilVolume,
-            ShadowOptions { crow_count: Counting::ZFail, ..d() },
-        ),
+        ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg),
+        ("crow zpass".into(), ShadowMethod::Crow(volumes(Counting::ZPass))),
+        ("crow zfail".into(), ShadowMethod::Crow(volumes(Counting::ZFail))),
+        ("stencil-volume zpass".into(), ShadowMethod::StencilVolume(volumes(Counting::ZPass))),
+        ("stencil-volume zfail".into(), ShadowMethod::StencilVolume(volumes(Counting::ZFail))),
     ]
 }
 

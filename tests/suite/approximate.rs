@@ -6,7 +6,7 @@ use crate::common;
 
 use common::*;
 use std::path::Path;
-use umbra::shadow::{ShadowFilter, ShadowOptions, WilliamsOptions};
+use umbra::shadow::{ShadowFilter, WilliamsOptions};
 use umbra::{Frame, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 fn floor_and_box(receiver: bool, light: &str) -> Scene {
@@ -64,11 +64,8 @@ fn shadow_map_matches_except_near_shadow_edges() {
         let scene = floor_and_box(false, light);
         let want = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::RayCast);
         for filter in [ShadowFilter::Nearest, ShadowFilter::Pcf(3)] {
-            let options = ShadowOptions {
-                williams: WilliamsOptions { map_size: 2048, filter, ..WilliamsOptions::default() },
-                ..ShadowOptions::default()
-            };
-            let got = frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams, options);
+            let options = WilliamsOptions { map_size: 2048, filter, ..WilliamsOptions::default() };
+            let got = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams(options));
             let (wrong, far) = errors_away_from_edges(&want, &got, 3);
             assert!(
                 far.is_empty(),
@@ -84,18 +81,15 @@ fn shadow_map_matches_except_near_shadow_edges() {
 fn shadow_map_without_bias_shows_acne() {
     let scene = floor_and_box(false, POINT);
     let want = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::RayCast);
-    let options = ShadowOptions {
-        williams: WilliamsOptions {
-            map_size: 512,
-            bias: Some(0.0),
-            slope_bias: 0.0,
-            normal_offset: 0.0,
-            filter: ShadowFilter::Nearest,
-            ..WilliamsOptions::default()
-        },
-        ..ShadowOptions::default()
+    let options = WilliamsOptions {
+        map_size: 512,
+        bias: Some(0.0),
+        slope_bias: 0.0,
+        normal_offset: 0.0,
+        filter: ShadowFilter::Nearest,
+        ..WilliamsOptions::default()
     };
-    let got = frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams, options);
+    let got = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams(options));
     let (_, far) = errors_away_from_edges(&want, &got, 3);
     assert!(far.len() > 500, "self-shadowing acne expected on lit surfaces, found {} pixels", far.len());
 }
@@ -131,8 +125,7 @@ fn williams_options_out_of_range_are_refused() {
         (WilliamsOptions { slope_bias: -1.0, ..Default::default() }, "slope bias -1"),
     ];
     for (williams, want) in bad {
-        let shadow_options = ShadowOptions { williams, ..Default::default() };
-        let opts = RenderOptions { shadows: ShadowMethod::Williams, shadow_options, ..Default::default() };
+        let opts = RenderOptions { shadows: ShadowMethod::Williams(williams), ..Default::default() };
         let err = umbra::render(&scene, &opts).unwrap_err().to_string();
         assert!(err.starts_with("williams: ") && err.contains(want), "{err}");
     }
@@ -152,7 +145,7 @@ fn seed_gaussian_weights() {
 /// larger nearness everywhere) come out as if drawn in fresh memory.
 #[test]
 fn reused_map_storage_leaves_nothing_behind() {
-    let options = RenderOptions { shadows: ShadowMethod::Williams, ..RenderOptions::default() };
+    let options = RenderOptions { shadows: ShadowMethod::Williams(Default::default()), ..RenderOptions::default() };
     let first = floor_and_box(false, "[[light]]\nkind = \"point\"\nposition = [1.5, 4.5, 1.0]\n");
     let second = floor_and_box(false, POINT);
     let mut renderer = umbra::Renderer::new();
@@ -168,7 +161,7 @@ fn reused_map_storage_leaves_nothing_behind() {
 /// map (2048², 3×3 PCF) differs from ray-cast.
 fn default_map_error(scene: &Scene) -> f64 {
     let want = frame(scene, VisibilityMethod::Scanline, ShadowMethod::RayCast);
-    let got = frame(scene, VisibilityMethod::Scanline, ShadowMethod::Williams);
+    let got = frame(scene, VisibilityMethod::Scanline, ShadowMethod::Williams(Default::default()));
     let (interior, wrong, _) = umbra::study::compare::diff(&want, &got);
     assert!(interior > 10_000, "{interior} interior pixels");
     wrong as f64 / interior as f64
@@ -215,8 +208,8 @@ fn shadows_stay_attached_at_grazing_contact() {
     let scene = example("grazing-light.toml");
     let want = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::RayCast);
     let with = |williams: WilliamsOptions| {
-        let options = ShadowOptions { williams, ..ShadowOptions::default() };
-        frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams, options)
+        let options = williams;
+        frame(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams(options))
     };
     let slope_only = with(WilliamsOptions { slope_bias: 1.0, normal_offset: 0.0, ..WilliamsOptions::default() });
     let (_, detached) = errors_away_from_edges(&want, &slope_only, 3);
@@ -236,8 +229,8 @@ fn receiver_plane_depth_bias_removes_acne() {
     let want = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::RayCast);
     let share = |receiver_plane: bool| {
         let williams = WilliamsOptions { normal_offset: 0.0, receiver_plane, ..WilliamsOptions::default() };
-        let options = ShadowOptions { williams, ..ShadowOptions::default() };
-        let got = frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams, options);
+        let options = williams;
+        let got = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::Williams(options));
         let (interior, wrong, _) = umbra::study::compare::diff(&want, &got);
         wrong as f64 / interior as f64
     };

@@ -4,7 +4,7 @@
 
 use serde_json::Value;
 use std::process::Command;
-use umbra::shadow::{ShadowMethod, ShadowOptions};
+use umbra::shadow::ShadowMethod;
 use umbra::study::explore::{export, Explorer, Response};
 use umbra::study::trace::trace;
 use umbra::Scene;
@@ -25,15 +25,15 @@ fn a_traced_line_is_what_trace_gives_at_the_requested_size() {
     let mut camera = small.camera().clone();
     (camera.width, camera.height) = (320, 240);
     small.set_camera(camera).unwrap();
-    for stage in [ShadowMethod::BouknightKelley, ShadowMethod::Crow, ShadowMethod::AthertonWeilerGreenberg] {
+    for stage in [
+        ShadowMethod::BouknightKelley(Default::default()),
+        ShadowMethod::Crow(Default::default()),
+        ShadowMethod::AthertonWeilerGreenberg,
+    ] {
         for line in [0, 77, 130, 239] {
             let r = explorer.handle(&format!("/api/trace?line={line}&shadows={}&width=320&height=240", stage.name()));
             assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
-            let want = serde_json::to_string(
-                &trace(&small, line, stage, &ShadowOptions { keep_outlines: true, ..ShadowOptions::default() })
-                    .unwrap(),
-            )
-            .unwrap();
+            let want = serde_json::to_string(&trace(&small, line, &stage).unwrap()).unwrap();
             // Both through the same text, so that both round the same way.
             let want: Value = serde_json::from_str(&want).unwrap();
             assert_eq!(json(&r), want, "{} line {line}", stage.name());

@@ -15,7 +15,7 @@
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use std::path::Path;
-use umbra::shadow::{ShadowOptions, WilliamsOptions};
+use umbra::shadow::WilliamsOptions;
 use umbra::{render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 /// Numbers that break naive code.
@@ -150,14 +150,14 @@ fn config(cases: u32) -> ProptestConfig {
 
 /// Renders with every visibility and shadow stage and checks the answer's invariants.
 fn render_all(scene: &Scene) {
-    let small_map = ShadowOptions {
-        williams: WilliamsOptions { map_size: 16, ..WilliamsOptions::default() },
-        ..ShadowOptions::default()
-    };
+    let small_map = WilliamsOptions { map_size: 16, ..WilliamsOptions::default() };
     for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer, VisibilityMethod::RayCast] {
         for s in ShadowMethod::ALL {
-            let opts =
-                RenderOptions { visibility: v, shadows: s, shadow_options: small_map.clone(), ..Default::default() };
+            let s = match s {
+                ShadowMethod::Williams(_) => ShadowMethod::Williams(small_map.clone()),
+                other => other,
+            };
+            let opts = RenderOptions { visibility: v, shadows: s.clone(), ..Default::default() };
             // An error is an answer; a panic fails the test.
             let Ok(out) = render(scene, &opts) else { continue };
             let f = &out.frame;

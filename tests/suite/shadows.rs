@@ -19,10 +19,10 @@ fn check(scene: &Scene, label: &str) -> (Agreement, usize) {
     let want = reference(scene);
     let shadowed = shadowed(&want);
     let mut agreement = Agreement::default();
-    let bk = frame(scene, VisibilityMethod::Scanline, ShadowMethod::BouknightKelley);
-    for (name, m, o) in exact_stages() {
+    let bk = frame(scene, VisibilityMethod::Scanline, ShadowMethod::BouknightKelley(Default::default()));
+    for (name, m) in exact_stages() {
         for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
-            let got = frame_with(scene, v, m, o.clone());
+            let got = frame(scene, v, m.clone());
             agreement += assert_light_agree(scene, &want, &got, &format!("{label} {name} behind {v}"));
             assert_light_agree(scene, &bk, &got, &format!("{label} {name} behind {v} against bouknight-kelley"));
         }
@@ -105,8 +105,8 @@ fn square_casts_its_central_projection() {
     let foot = glam::DVec2::new(light.x, light.z);
     let (lo, hi) = (foot + (glam::DVec2::splat(-half) - foot) * k, foot + (glam::DVec2::splat(half) - foot) * k);
     for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
-        for (name, m, o) in exact_stages() {
-            let f = frame_with(&scene, v, m, o);
+        for (name, m) in exact_stages() {
+            let f = frame(&scene, v, m);
             let (mut inside, mut outside) = (0, 0);
             for y in 0..150 {
                 for x in 0..200 {
@@ -145,12 +145,8 @@ fn naive_zpass_fails_when_the_eye_is_in_shadow() {
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/eye-in-shadow.toml");
     let scene = load_scaled(&path, 320);
     let want = reference(&scene);
-    let naive = frame_with(
-        &scene,
-        VisibilityMethod::Scanline,
-        ShadowMethod::Crow,
-        umbra::shadow::ShadowOptions { crow_count: Counting::NaiveZPass, ..Default::default() },
-    );
+    let naive_zpass = umbra::shadow::VolumeOptions { counting: Counting::NaiveZPass, ..Default::default() };
+    let naive = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::Crow(naive_zpass));
     let (mut wrong, mut wrong_lit_floor) = (0, 0);
     for y in 0..want.height {
         for x in 0..want.width {
@@ -187,8 +183,9 @@ fn one_shadow_database_serves_many_views() {
             scene.set_camera(c).expect("a valid camera");
         }
         let fresh = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg);
-        let options = umbra::shadow::ShadowOptions { awg_database: Some(db.clone()), ..Default::default() };
-        let reused = frame_with(&scene, VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg, options);
+        let mut renderer = umbra::Renderer::new().with_shadow_database(db.clone());
+        let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg, ..Default::default() };
+        let reused = renderer.render(&scene, &opts).unwrap().frame.clone();
         assert_eq!(fresh.light, reused.light, "view from {eye}");
         assert_light_agree(
             &scene,

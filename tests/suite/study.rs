@@ -73,7 +73,7 @@ fn compare_reports_every_method_and_a_valid_page() {
     let about = &json["about"];
     assert_eq!(about["umbra"], env!("CARGO_PKG_VERSION"));
     assert!(about["cores"].as_u64().unwrap() >= 1 && about["date_utc"].as_str().unwrap().starts_with("20"));
-    assert!(about["options"].as_str().unwrap().contains("crow_count"));
+    assert!(about["options"].as_str().unwrap().contains("Crow(VolumeOptions { counting: ZPass"));
     assert!(html.contains(about["date_utc"].as_str().unwrap()));
     for r in json["results"].as_array().unwrap().iter().filter(|r| r["status"] == "ok") {
         let (lo, mid, hi) =
@@ -96,7 +96,7 @@ fn trace_matches_a_hand_worked_line() {
                [[object]]\npolygons = [\n [[-1.0,-0.5,-1.0],[0.5,-0.5,-1.0],[0.5,0.5,-1.0],[-1.0,0.5,-1.0]],\n \
                [[0.0,-1.0,-2.0],[2.0,-1.0,-2.0],[2.0,1.0,-2.0],[0.0,1.0,-2.0]],\n]\n";
     let scene = Scene::from_toml(src, Path::new("t.toml"), Path::new(".")).unwrap();
-    let t = umbra::study::trace::trace(&scene, 3, ShadowMethod::BouknightKelley, &Default::default()).unwrap();
+    let t = umbra::study::trace::trace(&scene, 3, &ShadowMethod::DEFAULT).unwrap();
     let xs: Vec<(f64, u32)> = t.active.clone();
     let want = [(4.0, 0), (8.0, 1), (10.0, 0), (12.0, 1)];
     assert_eq!(xs.len(), 4);
@@ -146,7 +146,6 @@ fn scale_writes_csv_and_plots() {
             (umbra::VisibilityMethod::Scanline, ShadowMethod::None),
             (umbra::VisibilityMethod::ZBuffer, ShadowMethod::None),
         ],
-        shadow_options: Default::default(),
         runs: 1,
         width: 160,
         height: 90,
