@@ -1,6 +1,6 @@
 //! Pixels where one shadow stage differs from ray-cast on a scene, and how many of those are
 //! ties: `cargo run --release --example exact_one -- scene.toml crow [zfail]`.
-use umbra::shadow::volumes::Counting;
+use umbra::shadow::Counting;
 use umbra::shadow::VolumeOptions;
 use umbra::{render, RenderOptions, Scene, ShadowMethod};
 

@@ -2,7 +2,7 @@
 //! at every pixel, where each differs from the ray-cast reference (face id or lit fraction).
 //!
 //! `cargo run --release --example exactness -- scene.toml [more.toml ...]`
-use umbra::shadow::volumes::Counting;
+use umbra::shadow::Counting;
 use umbra::shadow::VolumeOptions;
 use umbra::{render, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 

@@ -10,15 +10,24 @@
 //!       ──shadow──▶ lit value per light sample ──shading──▶ Frame
 //! ```
 //!
-//! - [`scene`]: the scene file of `docs/scene-format.md` (TOML + OBJ), compiled to world polygons.
-//! - [`view`]: camera, pixel-centre rule, near/far clipping, projection.
-//! - [`scan`]: the edge table and active edge table every scanline stage walks.
-//! - [`visibility`]: Watkins' scanline algorithm, the z-buffer, and a ray-cast reference.
-//! - [`shadow`]: the shadow stages behind one trait.
-//! - [`shading`]: the illumination model.
-//! - [`frame`]: the image and its analysis buffers.
+//! What a program uses:
+//!
+//! - [`Scene`]: loaded from a TOML file ([`Scene::load`], the format of
+//!   `docs/scene-format.md`), built from parts ([`Scene::new`] and the types of [`scene`]),
+//!   or generated ([`generate`]).
 //! - [`render()`] renders one frame; a [`Renderer`] renders many, each in the memory of the
 //!   last (no frame-sized allocation after the first).
+//! - [`RenderOptions`]: the [`VisibilityMethod`], the [`ShadowMethod`] with its settings (the
+//!   types of [`shadow`]), the [`ReflectionMethod`].
+//! - [`Rendered`]: the [`Frame`] (colour, face id and lit fraction per pixel, and their PNG
+//!   encodings) and its [`Stats`] (the stages' [`Counters`] and times).
+//! - [`Error`]: what went wrong, on one line, naming the file and line where there is one.
+//!
+//! And to study the algorithms: [`reference`](mod@reference) (the exact answer by ray casting, and the
+//! definition of a tie), [`view`] (the camera's pixel-centre rule), [`visibility`] (one
+//! visibility stage alone), [`shading`] (the illumination model) and [`study`] (the
+//! `bench`, `compare`, `scale`, `trace` and `explore` tools). The algorithms themselves are
+//! one private module each, named after their paper, documented in `docs/algorithms/`.
 //!
 //! ```
 //! use umbra::{generate, render, RenderOptions, ShadowMethod, VisibilityMethod};
@@ -36,29 +45,32 @@
 //! ```
 #![warn(missing_docs)]
 
-pub mod budget;
-pub mod bvh;
-pub mod error;
-pub mod frame;
+mod budget;
+mod bvh;
+mod error;
+mod frame;
 pub mod generate;
-pub mod geometry;
+mod geometry;
 mod pool;
 mod progress;
 mod raster;
 pub mod reference;
-pub mod reflection;
-pub mod render;
-pub mod scan;
+mod reflection;
+mod render;
+mod scan;
 pub mod scene;
 pub mod shading;
 pub mod shadow;
-pub mod stats;
+mod stats;
 pub mod study;
 pub mod view;
 pub mod visibility;
 
 pub use error::{Error, FileLoc, Result};
-pub use frame::Frame;
+pub use frame::{check_gamma, Frame, PixelCounters, BACKGROUND, GAMMA_RANGE};
+/// The vector types the API takes and gives (points, directions, colours).
+pub use glam;
+pub use reflection::ReflectionMethod;
 pub use render::{render, RenderOptions, Rendered, Renderer};
 pub use scene::Scene;
 pub use shadow::ShadowMethod;

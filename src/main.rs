@@ -3,11 +3,11 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use umbra::reflection::ReflectionMethod;
-use umbra::shadow::volumes::Counting;
+use umbra::shadow::Counting;
 use umbra::shadow::{BouknightKelleyOptions, ShadowFilter, VolumeOptions, WilliamsOptions};
 use umbra::study::compare::{compare, CompareOptions};
 use umbra::study::scale::{scale, ScaleOptions, Sweep};
+use umbra::ReflectionMethod;
 use umbra::{generate, render, Error, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
 
 #[derive(Parser)]
@@ -717,7 +717,7 @@ fn write_png(img: image::RgbImage, path: &std::path::Path) -> umbra::Result<()> 
 
 fn parse_gamma(s: &str) -> Result<f32, String> {
     let g: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
-    umbra::frame::check_gamma(g).map(|()| g).map_err(|e| e.to_string())
+    umbra::check_gamma(g).map(|()| g).map_err(|e| e.to_string())
 }
 
 fn main() -> ExitCode {

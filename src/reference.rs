@@ -15,6 +15,7 @@
 //! and an exact stage must give it.
 
 use crate::bvh::Bvh;
+use crate::frame::BACKGROUND;
 use crate::scene::{LightSample, Scene};
 use crate::shadow::blocked;
 use crate::view::View;
@@ -137,4 +138,44 @@ impl<'a> Reference<'a> {
             LightSample::Directional(dir) => plane.n.dot(dir).abs() <= PLANE_TIE,
         })
     }
+}
+
+/// The reference for planar mirrors: for each pixel whose visible polygon is a mirror seen from the front, the
+/// face id the ray reflected there sees first (one bounce, by ray casting), else background.
+pub fn mirror_ids(scene: &Scene) -> Vec<u32> {
+    let view = View::new(&scene.camera);
+    let all = Bvh::new(scene, (0..scene.polygons.len() as u32).collect());
+    let mut out = vec![BACKGROUND; (view.width * view.height) as usize];
+    let far = view.far.unwrap_or(f64::INFINITY);
+    for y in 0..view.height {
+        for x in 0..view.width {
+            let d = view.ray(x as f64 + 0.5, y as f64 + 0.5);
+            let Some((p, t)) = all.closest(scene, view.eye, d, view.near, far) else { continue };
+            let poly = &scene.polygons[p as usize];
+            if scene.material(p as usize).mirror <= 0.0 || poly.plane.distance(view.eye) <= 0.0 {
+                continue;
+            }
+            let hit = view.eye + d * t;
+            let n = poly.plane.n;
+            let r = d - 2.0 * d.dot(n) * n;
+            // Mirrors are left out of the reflection (one level), and so is what lies behind
+            // the mirror's plane: the reflected ray never goes there. The far plane cuts what
+            // the eye sees, the virtual image behind the mirror: `r` is as long as `d` (one
+            // unit of camera depth), so a point at `s` along it has its image at depth t + s.
+            let mut best: Option<(u32, f64)> = None;
+            let mut tmin = 1e-9;
+            while let Some((q, s)) = all.closest(scene, hit, r, tmin, far - t) {
+                if scene.material(q as usize).mirror > 0.0 {
+                    tmin = s * (1.0 + 1e-12) + 1e-12;
+                    continue;
+                }
+                best = Some((q, s));
+                break;
+            }
+            if let Some((q, _)) = best {
+                out[(y * view.width + x) as usize] = scene.polygons[q as usize].face;
+            }
+        }
+    }
+    out
 }

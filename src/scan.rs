@@ -168,11 +168,6 @@ impl EdgeTable {
         self.edges = sorted;
     }
 
-    /// The lines on which any edge is active (after [`EdgeTable::finish`]).
-    pub fn lines(&self) -> Range<u32> {
-        self.lines.clone()
-    }
-
     /// Every edge as (tag, first line, end line, x at its top, y at its top, dx/dy).
     pub fn edges(&self) -> impl Iterator<Item = (u32, u32, u32, f64, f64, f64)> + '_ {
         self.edges.iter().map(|e| (e.tag, e.first, e.end, e.x_top, e.y_top, e.dxdy))
@@ -186,11 +181,6 @@ impl EdgeTable {
     /// Number of edges.
     pub fn len(&self) -> usize {
         self.edges.len()
-    }
-
-    /// Whether the table has no edges.
-    pub fn is_empty(&self) -> bool {
-        self.edges.is_empty()
     }
 
     fn starting_on(&self, line: u32) -> &[Edge] {
@@ -328,11 +318,6 @@ impl<'a> ActiveEdges<'a> {
     /// Bytes held by the walker.
     pub fn bytes(&self) -> usize {
         (self.active.capacity() + self.incoming.capacity() + self.merged.capacity()) * std::mem::size_of::<Crossing>()
-    }
-
-    /// Number of edges active on the current line.
-    pub fn active_len(&self) -> usize {
-        self.active.len()
     }
 }
 

@@ -111,7 +111,7 @@ fn specular(m: &Material, n: DVec3, v: DVec3, l: DVec3, nl: f64) -> f64 {
 }
 
 /// Shades runs of a scene seen from a view.
-pub struct Shader<'a> {
+pub(crate) struct Shader<'a> {
     scene: &'a Scene,
     view: &'a View,
     samples: &'a [Vec<LightSample>],
@@ -119,7 +119,7 @@ pub struct Shader<'a> {
 
 /// Per-run scratch: what one run needs whatever the light (reused from run to run).
 #[derive(Debug, Default)]
-pub struct RunShading {
+pub(crate) struct RunShading {
     poly: usize,
     mode: ShadingMode,
     /// +1 or -1: turns the polygon's normals toward the viewer.

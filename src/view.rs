@@ -37,7 +37,7 @@ pub struct View {
 
 /// `1/z = a x + b y + c` over screen position `(x, y)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DepthPlane {
+pub(crate) struct DepthPlane {
     /// d(1/z)/dx.
     pub a: f64,
     /// d(1/z)/dy.
@@ -56,7 +56,7 @@ impl DepthPlane {
 
 /// A polygon in screen space, ready to scan-convert.
 #[derive(Debug, Clone)]
-pub struct ScreenPolygon {
+pub(crate) struct ScreenPolygon {
     /// Index of the scene polygon it came from.
     pub poly: u32,
     /// Its vertices in screen space (one ring; near/far clipping keeps a single ring).
@@ -117,7 +117,7 @@ impl View {
 
     /// How [`View::ray`] changes from one pixel to the next along a line.
     #[inline]
-    pub fn ray_step(&self) -> DVec3 {
+    pub(crate) fn ray_step(&self) -> DVec3 {
         self.r * (2.0 * self.t * self.aspect / self.width as f64)
     }
 
@@ -130,7 +130,7 @@ impl View {
     }
 
     /// The inverse-depth plane of a world plane; `None` when the eye lies in it (edge-on).
-    pub fn depth_plane(&self, plane: &Plane) -> Option<DepthPlane> {
+    pub(crate) fn depth_plane(&self, plane: &Plane) -> Option<DepthPlane> {
         let e = plane.distance(self.eye);
         if e == 0.0 {
             return None;
@@ -147,21 +147,15 @@ impl View {
 
     /// Clips a world polygon to `near <= z (<= far)` in camera space and projects it.
     /// Returns `false` (and leaves `out` empty) when nothing is left.
-    pub fn clip_project(&self, verts: &[DVec3], scratch: &mut [Vec<DVec3>; 2], out: &mut Vec<DVec2>) -> bool {
+    pub(crate) fn clip_project(&self, verts: &[DVec3], scratch: &mut [Vec<DVec3>; 2], out: &mut Vec<DVec2>) -> bool {
         self.clip_project_to(verts, self.far, scratch, out)
-    }
-
-    /// As [`View::clip_project`], clipping by the near plane only (shadow-volume polygons must
-    /// not be cut by the far plane: that is what makes z-fail fail).
-    pub fn clip_project_near(&self, verts: &[DVec3], scratch: &mut [Vec<DVec3>; 2], out: &mut Vec<DVec2>) -> bool {
-        self.clip_project_to(verts, None, scratch, out)
     }
 
     /// Clips a polygon given in homogeneous world coordinates (`w = 0` for points at infinity,
     /// as shadow volumes extruded to infinity have) to the near plane and to a guard band
     /// 10⁴ times wider than the view, then projects it. The guard band keeps every point in
     /// front of the eye, so vanishing points project to finite (far off-screen) positions.
-    pub fn clip_project_homogeneous(
+    pub(crate) fn clip_project_homogeneous(
         &self,
         verts: &[DVec4],
         scratch: &mut [Vec<DVec4>; 2],
@@ -198,7 +192,7 @@ impl View {
 
     /// The near plane (normal along the view direction) and the corners of the part of it
     /// the image sees, grown by 1% so pixel centres at the border are inside.
-    pub fn near_rectangle(&self) -> (Plane, [DVec3; 4]) {
+    pub(crate) fn near_rectangle(&self) -> (Plane, [DVec3; 4]) {
         let c = self.eye + self.f * self.near;
         let (hx, hy) = (self.near * self.t * self.aspect * 1.01, self.near * self.t * 1.01);
         let corner = |sx: f64, sy: f64| c + self.r * (sx * hx) + self.u * (sy * hy);
@@ -250,7 +244,7 @@ impl View {
     }
 
     /// Every polygon of the scene that survives clipping, in screen space.
-    pub fn screen_polygons(&self, scene: &Scene) -> Vec<ScreenPolygon> {
+    pub(crate) fn screen_polygons(&self, scene: &Scene) -> Vec<ScreenPolygon> {
         let mut scratch = [Vec::new(), Vec::new()];
         let mut ring = Vec::new();
         let mut out = Vec::with_capacity(scene.polygons.len());

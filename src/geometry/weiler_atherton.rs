@@ -87,6 +87,7 @@ impl Region {
     }
 
     /// Its area (even-odd: holes subtract).
+    #[cfg(test)]
     pub fn area(&self) -> f64 {
         oriented(self).iter().map(|r| signed_area(r)).sum::<f64>()
     }
@@ -95,11 +96,6 @@ impl Region {
     pub fn bounds(&self) -> Option<(DVec2, DVec2)> {
         let first = *self.rings.iter().flatten().next()?;
         Some(self.rings.iter().flatten().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
-    }
-
-    /// Whether `p` is inside by the even-odd rule.
-    pub fn contains(&self, p: DVec2) -> bool {
-        self.rings.iter().filter(|r| inside_even_odd(r, p)).count() % 2 == 1
     }
 }
 
@@ -651,3 +647,7 @@ mod tests {
         check(&subject, &square(0.1, 0.1, 0.5), 0.25);
     }
 }
+
+#[cfg(test)]
+#[path = "weiler_atherton_proptests.rs"]
+mod proptests;

@@ -7,25 +7,28 @@
 //! pipeline (`render::walk_line`), before any stage is asked; stages only answer for runs the
 //! rule leaves lit.
 
-pub mod atherton_weiler_greenberg;
+mod atherton_weiler_greenberg;
 mod bouknight_kelley;
 mod crow;
 mod overlay;
-pub mod planar;
+mod planar;
 mod projection;
 mod ray_cast;
 mod stencil_volume;
-pub mod volumes;
-pub mod williams;
+pub(crate) mod volumes;
+mod williams;
 
-pub use atherton_weiler_greenberg::{AthertonWeilerGreenberg, ShadowDatabase};
-pub use bouknight_kelley::BouknightKelley;
-pub use crow::Crow;
-pub use planar::Planar;
+use atherton_weiler_greenberg::AthertonWeilerGreenberg;
+pub use atherton_weiler_greenberg::{DetailPolygon, ShadowDatabase};
+use bouknight_kelley::BouknightKelley;
+use crow::Crow;
+use planar::Planar;
 pub(crate) use ray_cast::blocked;
-pub use ray_cast::RayCastShadows;
-pub use stencil_volume::StencilVolume;
-pub use williams::{ShadowFilter, Williams, WilliamsOptions};
+use ray_cast::RayCastShadows;
+use stencil_volume::StencilVolume;
+pub use volumes::Counting;
+use williams::Williams;
+pub use williams::{ShadowFilter, WilliamsOptions};
 
 use crate::error::Result;
 use crate::scene::{LightSample, Scene};
@@ -75,7 +78,7 @@ impl Default for VolumeOptions {
 }
 
 /// What every shadow stage is prepared from.
-pub struct ShadowContext<'a> {
+pub(crate) struct ShadowContext<'a> {
     /// The scene.
     pub scene: &'a Scene,
     /// The view.
@@ -133,7 +136,7 @@ impl<'a> ShadowContext<'a> {
 }
 
 /// A prepared shadow stage.
-pub trait ShadowStage: Sync {
+pub(crate) trait ShadowStage: Sync {
     /// A walker for one band of lines; it is called in increasing line order.
     fn walker(&self) -> Box<dyn ShadowWalker + '_>;
 
@@ -151,7 +154,7 @@ pub trait ShadowStage: Sync {
 }
 
 /// Answers, line by line, which pixels of each visible run a light sample reaches.
-pub trait ShadowWalker {
+pub(crate) trait ShadowWalker {
     /// Called once for each line, in increasing order, before its runs.
     fn start_line(&mut self, _line: u32) {}
 

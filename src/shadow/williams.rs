@@ -864,8 +864,8 @@ fn blur(src: &[f32], w: usize, h: usize, taps: &[(i64, f32)], along_rows: bool) 
 /// i = 1, 3, …, 13 the offsets `+i` and `−i` weighted `2 G(i, 3)` and `2 G(i + 1, 3)`, with
 /// `G(x, ρ) = exp(−x²/2ρ²)/√(2πρ²)`. Reproduced as published: the taps skip even offsets,
 /// the two sides are weighted unequally, and the weights sum to about 1.07 (the blurred term
-/// is clamped to [0, 1], as the seed's 8-bit render target does).
-pub fn seed_gaussian_taps() -> Vec<(i64, f32)> {
+/// is clamped to [0, 1], as the article's 8-bit render target does).
+pub(crate) fn seed_gaussian_taps() -> Vec<(i64, f32)> {
     let g = |x: f64, rho: f64| (-(x * x) / (2.0 * rho * rho)).exp() / (2.0 * std::f64::consts::PI * rho * rho).sqrt();
     let mut taps = vec![(0i64, g(0.0, 2.0) as f32)];
     for i in (1..15).step_by(2) {
@@ -950,5 +950,20 @@ impl ShadowWalker for Walker<'_> {
 
     fn finish(&mut self, counters: &mut Counters) {
         counters.add("map_lookups", self.lookups);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seed_gaussian_weights() {
+        let taps = seed_gaussian_taps();
+        assert_eq!(taps.len(), 15);
+        let offsets: Vec<i64> = taps.iter().map(|t| t.0).collect();
+        assert_eq!(offsets, vec![0, 1, -1, 3, -3, 5, -5, 7, -7, 9, -9, 11, -11, 13, -13]);
+        let sum: f32 = taps.iter().map(|t| t.1).sum();
+        assert!((sum - 1.0665).abs() < 1e-3, "{sum}");
     }
 }

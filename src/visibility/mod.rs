@@ -6,9 +6,10 @@ mod ray_cast;
 mod scanline;
 mod zbuffer;
 
-pub use ray_cast::RayCastVisibility;
-pub use scanline::{ScanlineVisibility, SpanRecord};
-pub use zbuffer::ZBufferVisibility;
+use ray_cast::RayCastVisibility;
+pub(crate) use scanline::ScanlineVisibility;
+pub use scanline::SpanRecord;
+use zbuffer::ZBufferVisibility;
 
 use crate::pool::Pools;
 use crate::scene::Scene;
@@ -28,7 +29,7 @@ pub struct Run {
 }
 
 /// A prepared visibility stage.
-pub trait Visibility: Sync {
+pub(crate) trait Visibility: Sync {
     /// Walks `lines` in increasing order, calling `f(line, runs)` with each line's runs in
     /// increasing x (lines with no runs included). Several bands may be walked at once.
     fn walk(&self, lines: Range<u32>, counters: &mut Counters, f: &mut dyn FnMut(u32, &[Run]));
@@ -118,7 +119,7 @@ impl FrameRuns {
 }
 
 /// Walks every line of a prepared stage in parallel bands and keeps the runs.
-pub fn resolve(vis: &dyn Visibility, height: u32, counters: &mut Counters) -> FrameRuns {
+pub(crate) fn resolve(vis: &dyn Visibility, height: u32, counters: &mut Counters) -> FrameRuns {
     use rayon::prelude::*;
     let band = crate::scan::band_height(height);
     let bands: Vec<(Vec<Vec<Run>>, Counters)> = (0..height.div_ceil(band))

@@ -44,7 +44,7 @@ pub fn frame(scene: &Scene, visibility: VisibilityMethod, shadows: ShadowMethod)
 
 /// The exact scanline-family stages, with the settings that make them exact.
 pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
-    use umbra::shadow::volumes::Counting;
+    use umbra::shadow::Counting;
     use umbra::shadow::{BouknightKelleyOptions, VolumeOptions};
     let volumes = |counting| VolumeOptions { counting, ..VolumeOptions::default() };
     vec![

@@ -131,16 +131,6 @@ fn williams_options_out_of_range_are_refused() {
     }
 }
 
-#[test]
-fn seed_gaussian_weights() {
-    let taps = umbra::shadow::williams::seed_gaussian_taps();
-    assert_eq!(taps.len(), 15);
-    let offsets: Vec<i64> = taps.iter().map(|t| t.0).collect();
-    assert_eq!(offsets, vec![0, 1, -1, 3, -3, 5, -5, 7, -7, 9, -9, 11, -11, 13, -13]);
-    let sum: f32 = taps.iter().map(|t| t.1).sum();
-    assert!((sum - 1.0665).abs() < 1e-3, "{sum}");
-}
-
 /// Maps drawn in memory kept from an earlier render (with a nearer light, whose map holds
 /// larger nearness everywhere) come out as if drawn in fresh memory.
 #[test]

@@ -178,24 +178,6 @@ fn transforms_that_overflow_are_refused() {
 }
 
 #[test]
-fn huge_faces_load_in_linear_time() {
-    // 200,000 vertices on a circle: the diameter of the planarity rule is linear here.
-    let n = 200_000;
-    let mut obj = String::with_capacity(n * 40);
-    for k in 0..n {
-        let a = std::f64::consts::TAU * k as f64 / n as f64;
-        obj += &format!("v {} 0.5 {}\n", a.cos(), a.sin());
-    }
-    obj += "f";
-    for k in 1..=n {
-        obj += &format!(" {k}");
-    }
-    let mesh = umbra::scene::parse_obj(&obj, Path::new("big.obj")).unwrap();
-    let shape = umbra::geometry::classify_face(&mesh.positions);
-    assert!(matches!(shape, umbra::geometry::FaceShape::Planar(..)));
-}
-
-#[test]
 fn obj_vertices_take_three_numbers_and_an_optional_weight() {
     let e = umbra::scene::parse_obj("v 0 0 0 1 7\n", Path::new("m.obj")).unwrap_err().to_string();
     assert_eq!(e, "m.obj:1: 'v' takes at most four numbers, found '7'");

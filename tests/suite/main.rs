@@ -8,7 +8,6 @@ mod common;
 
 mod approximate;
 mod cli;
-mod clipper;
 mod explore;
 mod fuzz;
 mod loading;

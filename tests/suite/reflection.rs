@@ -4,8 +4,9 @@
 use crate::common;
 
 use common::*;
-use umbra::frame::BACKGROUND;
-use umbra::reflection::{reference_mirror_ids, ReflectionMethod};
+use umbra::reference::mirror_ids as reference_mirror_ids;
+use umbra::ReflectionMethod;
+use umbra::BACKGROUND;
 use umbra::{render, RenderOptions, Scene};
 
 fn mirror_scene() -> Scene {

@@ -141,7 +141,7 @@ fn square_casts_its_central_projection() {
 /// count and z-fail get it right.
 #[test]
 fn naive_zpass_fails_when_the_eye_is_in_shadow() {
-    use umbra::shadow::volumes::Counting;
+    use umbra::shadow::Counting;
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/eye-in-shadow.toml");
     let scene = load_scaled(&path, 320);
     let want = reference(&scene);

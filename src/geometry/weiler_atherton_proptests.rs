@@ -5,12 +5,12 @@
 //! independent intersection's area. proptest shrinks any failure and records it in
 //! `proptest-regressions/` so it is replayed first from then on.
 
+use super::{clip, signed_area, Region};
 use glam::DVec2;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
 use proptest::prelude::*;
-use umbra::geometry::weiler_atherton::{clip, signed_area, Region};
 
 fn independent_area(subject: &Region, clip_region: &Region, rule: OverlayRule) -> f64 {
     let conv = |r: &Region| -> Vec<Vec<[f64; 2]>> {
