@@ -459,198 +459,214 @@ fn scene_name(path: &std::path::Path) -> String {
 
 fn run(cli: Cli) -> umbra::Result<()> {
     match cli.command {
-        Command::Render(a) => {
-            check_png_name(&a.output)?;
-            let drawn = matches!(
-                a.shadows,
-                ShadowMethod::BouknightKelley(_)
-                    | ShadowMethod::AthertonWeilerGreenberg
-                    | ShadowMethod::Crow(_)
-                    | ShadowMethod::Planar
-            );
-            if a.debug.is_some() && !drawn {
-                return Err(Error::InvalidOption(format!(
-                    "--debug shadow-polygons draws the polygons of bouknight-kelley, atherton-weiler-greenberg, crow \
-                     and planar; {} has none to draw",
-                    a.shadows
-                )));
-            }
-            let scene = a.shadow.load(&a.scene)?;
-            let opts = RenderOptions {
-                visibility: a.visibility,
-                shadows: a.shadow.configure(a.shadows.clone()),
-                progress: true,
-                pixel_counters: a.aov.is_some(),
-                reflection: a.reflection,
-                outlines: a.debug.is_some(),
-            };
-            let out = render(&scene, &opts)?;
-            let mut img = out.frame.color_image(a.gamma);
-            if a.debug.is_some() {
-                umbra::Frame::draw_outlines(&mut img, &out.outlines, [255, 40, 200]);
-            }
-            write_png(img, &a.output)?;
-            let mut wrote = a.output.display().to_string();
-            if let Some(dir) = &a.aov {
-                out.frame.save_aovs(dir)?;
-                wrote += &format!(" and the analysis buffers in {}", dir.display());
-            }
-            say(&format!("wrote {wrote}"))?;
-            if a.stats {
-                let json = serde_json::to_string(&out.stats).map_err(|e| Error::Internal(e.to_string()))?;
-                stdout(&format!("{json}\n"))?;
-            }
-            Ok(())
-        }
-        Command::Compare(a) => {
-            let scene = a.shadow.load(&a.scene)?;
-            let d = CompareOptions::default();
-            let opts = CompareOptions {
-                visibility: if a.visibility.is_empty() { d.visibility } else { a.visibility },
-                shadows: a.shadow.configure_all(if a.shadows.is_empty() { d.shadows } else { a.shadows }),
-                warmup: a.warmup,
-                runs: a.runs,
-                out: a.out.clone(),
-                progress: true,
-            };
-            let report = compare(&scene, &scene_name(&a.scene), &opts)?;
-            let mut table = String::new();
-            for r in &report.results {
-                table += &format!(
-                    "{:>9} + {:<26} {:>9.1} ms ({:.1}–{:.1})  {:>8} / {:<8} wrong  {}\n",
-                    r.visibility,
-                    r.shadows,
-                    r.time.median_ms,
-                    r.time.min_ms,
-                    r.time.max_ms,
-                    r.wrong_pixels,
-                    r.interior_pixels,
-                    r.status
-                );
-            }
-            stdout(&table)?;
-            say(&format!("wrote {}", a.out.join("report.html").display()))
-        }
-        Command::Bench(a) => {
-            let scene = a.shadow.load(&a.scene)?;
-            let opts = umbra::study::bench::BenchOptions {
-                visibility: a.visibility,
-                shadows: a.shadow.configure_all(a.shadows),
-                warmup: a.warmup,
-                runs: a.runs,
-            };
-            let threads = a.threads.unwrap_or(0);
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .map_err(|e| Error::InvalidOption(format!("cannot start {threads} threads: {e}")))?;
-            let rows = pool.install(|| {
-                umbra::study::bench::bench(&scene, &opts, |what| {
-                    use std::io::Write;
-                    let _ = writeln!(std::io::stderr(), "bench: {what}");
-                })
-            })?;
-            if a.json {
-                let mut text = String::new();
-                for r in &rows {
-                    text += &serde_json::to_string(r).map_err(|e| Error::Internal(e.to_string()))?;
-                    text.push('\n');
-                }
-                stdout(&text)
-            } else {
-                stdout(&umbra::study::bench::table(&rows))
-            }
-        }
-        Command::Scale(a) => {
-            if !a.shadow.receiver.is_empty() {
-                return Err(Error::InvalidOption(
-                    "--receiver marks objects of a scene file, and scale generates its scenes: it cannot be used here"
-                        .into(),
-                ));
-            }
-            let methods = if a.methods.is_empty() {
-                vec![(VisibilityMethod::Scanline, ShadowMethod::None), (VisibilityMethod::ZBuffer, ShadowMethod::None)]
-            } else {
-                a.methods.into_iter().map(|(v, s)| (v, a.shadow.configure(s))).collect()
-            };
-            let opts = ScaleOptions {
-                sweep: a.sweep,
-                values: a.values,
-                methods,
-                runs: a.runs,
-                width: a.width,
-                height: a.height,
-                count: a.count,
-                size: a.size,
-                counter: a.counter,
-                out: a.out.clone(),
-            };
-            let mut table = String::new();
-            for p in scale(&opts)? {
-                table += &format!(
-                    "{:>10} {:>9} + {:<26} {:>9.1} ms ({:.1}–{:.1})  {}\n",
-                    p.value, p.visibility, p.shadows, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
-                );
-            }
-            stdout(&table)?;
-            say(&format!("wrote {}", a.out.display()))
-        }
-        Command::Trace(a) => {
-            let scene = a.shadow.load(&a.scene)?;
-            let t = umbra::study::trace::trace(&scene, a.line, &a.shadow.configure(a.shadows.clone()))?;
-            if let Some(x) = a.x.filter(|&x| x >= scene.camera().width) {
-                return Err(Error::InvalidOption(format!(
-                    "--x {x} is outside the image (width {})",
-                    scene.camera().width
-                )));
-            }
-            if a.json {
-                let json = serde_json::to_string_pretty(&t).map_err(|e| Error::Internal(e.to_string()))?;
-                stdout(&format!("{json}\n"))
-            } else {
-                stdout(&t.text(&scene, a.x))
-            }
-        }
+        Command::Render(a) => render_command(a),
+        Command::Compare(a) => compare_command(a),
+        Command::Bench(a) => bench_command(a),
+        Command::Scale(a) => scale_command(a),
+        Command::Trace(a) => trace_command(a),
         #[cfg(feature = "explore")]
         Command::Explore(a) => explore(a),
-        Command::ExportShadows(e) => {
-            let scene = Scene::load(&e.scene)?;
-            if e.light >= scene.lights().len() {
-                return Err(Error::InvalidOption(format!(
-                    "{}: no light {} (the scene has {} light(s), numbered from 0)",
-                    e.scene.display(),
-                    e.light,
-                    scene.lights().len()
-                )));
-            }
-            refuse_overwrite(std::slice::from_ref(&e.output), e.force)?;
-            let mut counters = umbra::Counters::default();
-            let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, &mut counters)?;
-            db.write_obj(&scene, &e.output)?;
-            let polygons: usize = db.samples.iter().map(Vec::len).sum();
-            say(&format!("wrote {}: {polygons} lit detail polygon(s) of light {}", e.output.display(), e.light))
-        }
-        Command::Generate(g) => {
-            let scene = match g.family {
-                Family::Cubes => generate::cubes(g.n, !g.quads, g.width, g.height)?,
-                Family::Quads => generate::stacked_quads(g.depth, g.width, g.height)?,
-                Family::Spheres => generate::spheres(g.triangles, g.count, g.width, g.height)?,
-            };
-            let dir = g.output.parent().unwrap_or(std::path::Path::new("")).join("meshes");
-            let stem = g.output.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-            let meshes: Vec<PathBuf> =
-                (0..scene.objects().len()).map(|i| dir.join(format!("{stem}_{i}.obj"))).collect();
-            refuse_overwrite(&[&[g.output.clone()][..], &meshes].concat(), g.force)?;
-            scene.write(&g.output)?;
-            say(&format!(
-                "wrote {} ({} polygons) and {} mesh(es) in {}",
-                g.output.display(),
-                scene.polygons().len(),
-                meshes.len(),
-                dir.display()
-            ))
-        }
+        Command::ExportShadows(e) => export_shadows_command(e),
+        Command::Generate(g) => generate_command(g),
     }
+}
+
+/// `umbra render`: one frame, its analysis buffers and its stats.
+fn render_command(a: RenderArgs) -> umbra::Result<()> {
+    check_png_name(&a.output)?;
+    let drawn = matches!(
+        a.shadows,
+        ShadowMethod::BouknightKelley(_)
+            | ShadowMethod::AthertonWeilerGreenberg
+            | ShadowMethod::Crow(_)
+            | ShadowMethod::Planar
+    );
+    if a.debug.is_some() && !drawn {
+        return Err(Error::InvalidOption(format!(
+            "--debug shadow-polygons draws the polygons of bouknight-kelley, atherton-weiler-greenberg, crow \
+             and planar; {} has none to draw",
+            a.shadows
+        )));
+    }
+    let scene = a.shadow.load(&a.scene)?;
+    let opts = RenderOptions {
+        visibility: a.visibility,
+        shadows: a.shadow.configure(a.shadows.clone()),
+        progress: true,
+        pixel_counters: a.aov.is_some(),
+        reflection: a.reflection,
+        outlines: a.debug.is_some(),
+    };
+    let out = render(&scene, &opts)?;
+    let mut img = out.frame.color_image(a.gamma);
+    if a.debug.is_some() {
+        umbra::Frame::draw_outlines(&mut img, &out.outlines, [255, 40, 200]);
+    }
+    write_png(img, &a.output)?;
+    let mut wrote = a.output.display().to_string();
+    if let Some(dir) = &a.aov {
+        out.frame.save_aovs(dir)?;
+        wrote += &format!(" and the analysis buffers in {}", dir.display());
+    }
+    say(&format!("wrote {wrote}"))?;
+    if a.stats {
+        let json = serde_json::to_string(&out.stats).map_err(|e| Error::Internal(e.to_string()))?;
+        stdout(&format!("{json}\n"))?;
+    }
+    Ok(())
+}
+
+/// `umbra compare`: every method against the ray-cast reference, as a report.
+fn compare_command(a: CompareArgs) -> umbra::Result<()> {
+    let scene = a.shadow.load(&a.scene)?;
+    let d = CompareOptions::default();
+    let opts = CompareOptions {
+        visibility: if a.visibility.is_empty() { d.visibility } else { a.visibility },
+        shadows: a.shadow.configure_all(if a.shadows.is_empty() { d.shadows } else { a.shadows }),
+        warmup: a.warmup,
+        runs: a.runs,
+        out: a.out.clone(),
+        progress: true,
+    };
+    let report = compare(&scene, &scene_name(&a.scene), &opts)?;
+    let mut table = String::new();
+    for r in &report.results {
+        table += &format!(
+            "{:>9} + {:<26} {:>9.1} ms ({:.1}–{:.1})  {:>8} / {:<8} wrong  {}\n",
+            r.visibility,
+            r.shadows,
+            r.time.median_ms,
+            r.time.min_ms,
+            r.time.max_ms,
+            r.wrong_pixels,
+            r.interior_pixels,
+            r.status
+        );
+    }
+    stdout(&table)?;
+    say(&format!("wrote {}", a.out.join("report.html").display()))
+}
+
+/// `umbra bench`: each method's frame and phases, timed.
+fn bench_command(a: BenchArgs) -> umbra::Result<()> {
+    let scene = a.shadow.load(&a.scene)?;
+    let opts = umbra::study::bench::BenchOptions {
+        visibility: a.visibility,
+        shadows: a.shadow.configure_all(a.shadows),
+        warmup: a.warmup,
+        runs: a.runs,
+    };
+    let threads = a.threads.unwrap_or(0);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::InvalidOption(format!("cannot start {threads} threads: {e}")))?;
+    let rows = pool.install(|| {
+        umbra::study::bench::bench(&scene, &opts, |what| {
+            use std::io::Write;
+            let _ = writeln!(std::io::stderr(), "bench: {what}");
+        })
+    })?;
+    if a.json {
+        let mut text = String::new();
+        for r in &rows {
+            text += &serde_json::to_string(r).map_err(|e| Error::Internal(e.to_string()))?;
+            text.push('\n');
+        }
+        stdout(&text)
+    } else {
+        stdout(&umbra::study::bench::table(&rows))
+    }
+}
+
+/// `umbra scale`: a sweep of generated scenes.
+fn scale_command(a: ScaleArgs) -> umbra::Result<()> {
+    if !a.shadow.receiver.is_empty() {
+        return Err(Error::InvalidOption(
+            "--receiver marks objects of a scene file, and scale generates its scenes: it cannot be used here".into(),
+        ));
+    }
+    let methods = if a.methods.is_empty() {
+        vec![(VisibilityMethod::Scanline, ShadowMethod::None), (VisibilityMethod::ZBuffer, ShadowMethod::None)]
+    } else {
+        a.methods.into_iter().map(|(v, s)| (v, a.shadow.configure(s))).collect()
+    };
+    let opts = ScaleOptions {
+        sweep: a.sweep,
+        values: a.values,
+        methods,
+        runs: a.runs,
+        width: a.width,
+        height: a.height,
+        count: a.count,
+        size: a.size,
+        counter: a.counter,
+        out: a.out.clone(),
+    };
+    let mut table = String::new();
+    for p in scale(&opts)? {
+        table += &format!(
+            "{:>10} {:>9} + {:<26} {:>9.1} ms ({:.1}–{:.1})  {}\n",
+            p.value, p.visibility, p.shadows, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
+        );
+    }
+    stdout(&table)?;
+    say(&format!("wrote {}", a.out.display()))
+}
+
+/// `umbra trace`: one line, step by step.
+fn trace_command(a: TraceArgs) -> umbra::Result<()> {
+    let scene = a.shadow.load(&a.scene)?;
+    let t = umbra::study::trace::trace(&scene, a.line, &a.shadow.configure(a.shadows.clone()))?;
+    if let Some(x) = a.x.filter(|&x| x >= scene.camera().width) {
+        return Err(Error::InvalidOption(format!("--x {x} is outside the image (width {})", scene.camera().width)));
+    }
+    if a.json {
+        let json = serde_json::to_string_pretty(&t).map_err(|e| Error::Internal(e.to_string()))?;
+        stdout(&format!("{json}\n"))
+    } else {
+        stdout(&t.text(&scene, a.x))
+    }
+}
+
+/// `umbra export-shadows`: a light's Atherton-Weiler-Greenberg database as OBJ.
+fn export_shadows_command(e: ExportArgs) -> umbra::Result<()> {
+    let scene = Scene::load(&e.scene)?;
+    if e.light >= scene.lights().len() {
+        return Err(Error::InvalidOption(format!(
+            "{}: no light {} (the scene has {} light(s), numbered from 0)",
+            e.scene.display(),
+            e.light,
+            scene.lights().len()
+        )));
+    }
+    refuse_overwrite(std::slice::from_ref(&e.output), e.force)?;
+    let mut counters = umbra::Counters::default();
+    let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, &mut counters)?;
+    db.write_obj(&scene, &e.output)?;
+    let polygons: usize = db.samples.iter().map(Vec::len).sum();
+    say(&format!("wrote {}: {polygons} lit detail polygon(s) of light {}", e.output.display(), e.light))
+}
+
+/// `umbra generate`: a benchmark scene written as files.
+fn generate_command(g: GenerateArgs) -> umbra::Result<()> {
+    let scene = match g.family {
+        Family::Cubes => generate::cubes(g.n, !g.quads, g.width, g.height)?,
+        Family::Quads => generate::stacked_quads(g.depth, g.width, g.height)?,
+        Family::Spheres => generate::spheres(g.triangles, g.count, g.width, g.height)?,
+    };
+    let dir = g.output.parent().unwrap_or(std::path::Path::new("")).join("meshes");
+    let stem = g.output.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+    let meshes: Vec<PathBuf> = (0..scene.objects().len()).map(|i| dir.join(format!("{stem}_{i}.obj"))).collect();
+    refuse_overwrite(&[&[g.output.clone()][..], &meshes].concat(), g.force)?;
+    scene.write(&g.output)?;
+    say(&format!(
+        "wrote {} ({} polygons) and {} mesh(es) in {}",
+        g.output.display(),
+        scene.polygons().len(),
+        meshes.len(),
+        dir.display()
+    ))
 }
 
 /// Refuses to write over files that exist, unless told to (`--force`).

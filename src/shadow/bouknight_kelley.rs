@@ -103,53 +103,89 @@ fn shadow_polygons(
     let grid = options.prefilter.then(|| SphereGrid::new(scene, sample, &casters));
     counters.add("prefilter_grid_us", t.elapsed().as_micros() as u64);
 
-    let record = ctx.keep_outlines;
     let per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>, Pairs)> = receivers
         .par_iter()
         .map_init(
             || (Projector::default(), vec![u32::MAX; n], [Vec::new(), Vec::new()], Vec::new()),
             |(proj, stamp, scratch, ring), &b| {
-                let mut tally = Tally::default();
                 let t = Instant::now();
                 let candidates: Vec<u32> = match &grid {
                     Some(g) => g.candidates(b, stamp),
                     None => casters.clone(),
                 };
-                tally.prefilter_ns += t.elapsed().as_nanos() as u64;
+                let prefilter_ns = t.elapsed().as_nanos() as u64;
                 let t = Instant::now();
-                let mut rings = Vec::new();
-                let mut pairs = Pairs::default();
-                let plane = scene.polygons[b as usize].plane;
-                let side = light_side(&plane, sample);
-                let rect = bounding_rectangle(scene.verts(b as usize), &plane);
-                for a in candidates {
-                    if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
-                        continue;
-                    }
-                    tally.kept += 1;
-                    if record {
-                        pairs.kept.push(a);
-                    }
-                    if scene.verts(a as usize).iter().all(|&v| plane.distance(v) * side <= 0.0) {
-                        tally.behind += 1;
-                        if record {
-                            pairs.behind.push(a);
-                        }
-                    } else if !proj.project(scene.verts(a as usize), &plane, &rect, sample) {
-                        tally.empty += 1;
-                    } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
-                        rings.push(ring.clone());
-                        if record {
-                            pairs.shadow_polygons.push((0, a));
-                        }
-                    }
-                }
+                let (mut tally, rings, pairs) = project_onto(ctx, sample, b, candidates, proj, scratch, ring);
+                tally.prefilter_ns += prefilter_ns;
                 tally.projection_ns += t.elapsed().as_nanos() as u64;
                 (b, tally, rings, pairs)
             },
         )
         .collect();
 
+    let (overlay, total, kept_pairs) = merge(ctx, per_receiver);
+    if options.prefilter {
+        counters.add("pairs_kept_by_prefilter", total.kept);
+    }
+    counters.add("pairs_dropped_behind", total.behind);
+    counters.add("projections_empty", total.empty);
+    counters.add("shadow_polygons", overlay.len() as u64);
+    counters.add("prefilter_cpu_us", total.prefilter_ns / 1000);
+    counters.add("projection_cpu_us", total.projection_ns / 1000);
+    (overlay, kept_pairs)
+}
+
+/// Steps 2 and 3 for receiver `b`: each candidate caster (not a piece of `b`'s own face) is
+/// dropped when wholly behind `b` as the light sees it, else projected from the light onto
+/// `b`'s plane and into the image. Returns the tally, the shadow polygons' screen rings, and
+/// (for traces) what became of each pair.
+fn project_onto(
+    ctx: &ShadowContext,
+    sample: LightSample,
+    b: u32,
+    candidates: Vec<u32>,
+    proj: &mut Projector,
+    scratch: &mut [Vec<DVec3>; 2],
+    ring: &mut Vec<DVec2>,
+) -> (Tally, Vec<Vec<DVec2>>, Pairs) {
+    let (scene, record) = (ctx.scene, ctx.keep_outlines);
+    let mut tally = Tally::default();
+    let mut rings = Vec::new();
+    let mut pairs = Pairs::default();
+    let plane = scene.polygons[b as usize].plane;
+    let side = light_side(&plane, sample);
+    let rect = bounding_rectangle(scene.verts(b as usize), &plane);
+    for a in candidates {
+        if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
+            continue;
+        }
+        tally.kept += 1;
+        if record {
+            pairs.kept.push(a);
+        }
+        if scene.verts(a as usize).iter().all(|&v| plane.distance(v) * side <= 0.0) {
+            tally.behind += 1;
+            if record {
+                pairs.behind.push(a);
+            }
+        } else if !proj.project(scene.verts(a as usize), &plane, &rect, sample) {
+            tally.empty += 1;
+        } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
+            rings.push(ring.clone());
+            if record {
+                pairs.shadow_polygons.push((0, a));
+            }
+        }
+    }
+    (tally, rings, pairs)
+}
+
+/// Every receiver's shadow polygons into one overlay, tagged with their receiver, and the
+/// tallies summed.
+fn merge(
+    ctx: &ShadowContext,
+    per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>, Pairs)>,
+) -> (Overlay, Tally, FxHashMap<u32, Pairs>) {
     let mut overlay = Overlay::new(ctx.view.height, ctx.keep_outlines);
     let mut total = Tally::default();
     let mut kept_pairs = FxHashMap::default();
@@ -161,20 +197,12 @@ fn shadow_polygons(
                 p.0 = tag;
             }
         }
-        if record {
+        if ctx.keep_outlines {
             kept_pairs.insert(b, pairs);
         }
     }
     overlay.finish();
-    if options.prefilter {
-        counters.add("pairs_kept_by_prefilter", total.kept);
-    }
-    counters.add("pairs_dropped_behind", total.behind);
-    counters.add("projections_empty", total.empty);
-    counters.add("shadow_polygons", overlay.len() as u64);
-    counters.add("prefilter_cpu_us", total.prefilter_ns / 1000);
-    counters.add("projection_cpu_us", total.projection_ns / 1000);
-    (overlay, kept_pairs)
+    (overlay, total, kept_pairs)
 }
 
 /// What happened to one receiver's pairs.

@@ -29,6 +29,7 @@ use super::volumes::{Adjacency, Counting, ScreenVolumes, NONE};
 use super::{CountAdd, Decision, Detail, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
 use crate::scan::{boundary, ActiveEdges, EdgeTable};
 use crate::stats::Counters;
+use crate::view::DepthPlane;
 use crate::visibility::Run;
 use glam::DVec2;
 
@@ -114,6 +115,27 @@ struct LineState<'a> {
 }
 
 impl LineState<'_> {
+    /// Step 1, the pairing: the pieces of `run` each shadow polygon covers, as (polygon,
+    /// first pixel, end), by walking the line's crossings to the run's end.
+    fn pieces_in(&mut self, run: &Run, pieces: &mut Vec<(u32, u32, u32)>) {
+        // Bring the walk to the run's first pixel: the open polygons then cover it.
+        while self.cursor < self.xs.len() && self.xs[self.cursor].0 <= run.x0 {
+            let (_, t) = self.xs[self.cursor];
+            self.toggle(t, run.x0, |_, _, _| {});
+            self.cursor += 1;
+        }
+        for o in &mut self.open_list {
+            o.1 = run.x0;
+        }
+        pieces.clear();
+        while self.cursor < self.xs.len() && self.xs[self.cursor].0 < run.x1 {
+            let (at, t) = self.xs[self.cursor];
+            self.toggle(t, at, |t, s, e| pieces.push((t, s, e)));
+            self.cursor += 1;
+        }
+        pieces.extend(self.open_list.iter().map(|&(t, s)| (t, s, run.x1)));
+    }
+
     fn toggle(&mut self, tag: u32, at: u32, mut closed: impl FnMut(u32, u32, u32)) {
         let slot = self.open[tag as usize];
         if slot == NONE {
@@ -145,74 +167,29 @@ struct Walker<'s> {
     split: u64,
 }
 
-impl ShadowWalker for Walker<'_> {
-    fn start_line(&mut self, line: u32) {
-        self.yc = line as f64 + 0.5;
-        let width = self.stage.ctx.view.width;
-        for st in &mut self.lines {
-            let xs = st.aet.advance_to(line);
-            st.xs.clear();
-            st.xs.extend(xs.iter().map(|c| (boundary(c.x, width), c.tag)));
-            st.cursor = 0;
-            for &(t, _) in &st.open_list {
-                st.open[t as usize] = NONE;
-            }
-            st.open_list.clear();
-        }
-    }
-
-    fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
-        let k = self.stage.ctx.sample_index(light, sample);
+impl Walker<'_> {
+    /// Step 2, the plane crossings: where each covering piece starts and stops adding to the
+    /// count along the run (`events`), a piece whose shadow polygon crosses the run's plane
+    /// inside it being cut at the first pixel that counts differently.
+    fn count_events(&mut self, k: usize, run: &Run, bd: DepthPlane, pieces: &[(u32, u32, u32)]) {
         let polys = &self.stage.samples[k].volumes.polys;
-        let scene = self.stage.ctx.scene;
-        let b = run.poly;
-        let face = scene.polygons[b as usize].face;
-        let Some(bd) = self.stage.ctx.view.depth_plane(&scene.polygons[b as usize].plane) else {
-            lit.fill(1.0);
-            return;
-        };
-        let (counting, yc) = (self.stage.counting, self.yc);
-        let st = &mut self.lines[k];
-        // Bring the walk to the run's first pixel: the open polygons then cover it.
-        while st.cursor < st.xs.len() && st.xs[st.cursor].0 <= run.x0 {
-            let (_, t) = st.xs[st.cursor];
-            st.toggle(t, run.x0, |_, _, _| {});
-            st.cursor += 1;
-        }
-        // Pieces of coverage within the run: (polygon, first pixel, end).
-        for o in &mut st.open_list {
-            o.1 = run.x0;
-        }
-        let mut pieces = std::mem::take(&mut self.last_pieces);
-        pieces.clear();
-        while st.cursor < st.xs.len() && st.xs[st.cursor].0 < run.x1 {
-            let (at, t) = st.xs[st.cursor];
-            st.toggle(t, at, |t, s, e| pieces.push((t, s, e)));
-            st.cursor += 1;
-        }
-        for &(t, s) in &st.open_list {
-            pieces.push((t, s, run.x1));
-        }
-        // Events: where each covering polygon starts and stops counting.
+        let (b, face) = (run.poly, self.stage.ctx.scene.polygons[run.poly as usize].face);
+        let (counting, yc, record) = (self.stage.counting, self.yc, self.stage.ctx.keep_outlines);
         self.events.clear();
-        self.last_counts.clear();
         self.last_adds.clear();
-        for &(t, s, e) in &pieces {
-            if s >= e {
-                continue;
-            }
+        for &(t, s, e) in pieces.iter().filter(|p| p.1 < p.2) {
             let p = &polys[t as usize];
-            let (adds, record) = (&mut self.last_adds, self.stage.ctx.keep_outlines);
             // What polygon p adds to the count at pixel x (see `count_at`).
             let counts = |x: u32| {
                 let xc = x as f64 + 0.5;
                 p.count_at(counting, b, face, xc, yc, bd.inv_z(xc, yc))
             };
             let (first, last) = (counts(s), counts(e - 1));
+            let (events, adds) = (&mut self.events, &mut self.last_adds);
             let mut add = |a: u32, z: u32, c: i32| {
                 if a < z && c != 0 {
-                    self.events.push((a, c));
-                    self.events.push((z, -c));
+                    events.push((a, c));
+                    events.push((z, -c));
                     // Kept for traces only: a render never asks for them.
                     if record {
                         adds.push(CountAdd { polygon: t, start: a, end: z, add: c, near_cap: p.near_cap });
@@ -236,11 +213,15 @@ impl ShadowWalker for Walker<'_> {
             add(s, m, first);
             add(m, e, last);
         }
-        self.last_pieces = pieces;
-        // Sweep: the count is constant between events.
+    }
+
+    /// Step 3, the count: swept along the run, constant between events; a pixel is in
+    /// shadow where it is above zero.
+    fn sweep(&mut self, run: &Run, lit: &mut [f32]) {
         self.events.sort_unstable_by_key(|e| e.0);
         self.runs += 1;
         self.events_total += self.events.len() as u64;
+        self.last_counts.clear();
         let (mut count, mut x, mut pieces_made) = (0i32, run.x0, 0);
         let mut i = 0;
         while x < run.x1 {
@@ -257,6 +238,37 @@ impl ShadowWalker for Walker<'_> {
         if pieces_made > 1 {
             self.split += 1;
         }
+    }
+}
+
+impl ShadowWalker for Walker<'_> {
+    fn start_line(&mut self, line: u32) {
+        self.yc = line as f64 + 0.5;
+        let width = self.stage.ctx.view.width;
+        for st in &mut self.lines {
+            let xs = st.aet.advance_to(line);
+            st.xs.clear();
+            st.xs.extend(xs.iter().map(|c| (boundary(c.x, width), c.tag)));
+            st.cursor = 0;
+            for &(t, _) in &st.open_list {
+                st.open[t as usize] = NONE;
+            }
+            st.open_list.clear();
+        }
+    }
+
+    fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
+        let k = self.stage.ctx.sample_index(light, sample);
+        let scene = self.stage.ctx.scene;
+        let Some(bd) = self.stage.ctx.view.depth_plane(&scene.polygons[run.poly as usize].plane) else {
+            lit.fill(1.0);
+            return;
+        };
+        let mut pieces = std::mem::take(&mut self.last_pieces);
+        self.lines[k].pieces_in(run, &mut pieces);
+        self.count_events(k, run, bd, &pieces);
+        self.last_pieces = pieces;
+        self.sweep(run, lit);
     }
 
     fn decision(&self) -> Decision {
