@@ -226,7 +226,9 @@ struct Edge {
     splits: Vec<(f64, u32)>,
 }
 
-/// Clips `subject` by `clip` into its parts inside and outside `clip`.
+/// Clips `subject` by `clip` into its parts inside and outside `clip`: step 1 splits both
+/// regions' edges where they meet, step 2 classifies each piece as inside or outside the
+/// other region, step 3 traces the pieces of each part back into rings.
 pub fn clip(subject: &Region, clip: &Region) -> Result<Clipped, ClipError> {
     let finite = |r: &Region| r.rings.iter().flatten().all(|p| p.is_finite());
     if !finite(subject) || !finite(clip) {
@@ -236,21 +238,7 @@ pub fn clip(subject: &Region, clip: &Region) -> Result<Clipped, ClipError> {
         return Ok(Clipped { inside: Region::default(), outside: subject.clone() });
     };
     let eps = 1e-9 * (sb.1.max(cb.1) - sb.0.min(cb.0)).length().max(1e-300);
-    let ring_box =
-        |r: &Ring| r.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    let meets = |r: &Ring, b: (DVec2, DVec2)| {
-        let (lo, hi) = ring_box(r);
-        lo.x <= b.1.x + eps && b.0.x <= hi.x + eps && lo.y <= b.1.y + eps && b.0.y <= hi.y + eps
-    };
-    // A ring whose box misses the other region's box cannot change anything inside that box
-    // (by the even-odd rule): subject rings there pass to the outside part untouched, clip
-    // rings there are dropped. Rings with no area (slivers, lines walked there and back)
-    // bound nothing and are dropped too.
-    let solid = |r: &Ring| signed_area(r).abs() > eps * eps;
-    let (near, far): (Vec<Ring>, Vec<Ring>) =
-        subject.rings.iter().filter(|r| solid(r)).cloned().partition(|r| meets(r, cb));
-    let c_near: Vec<Ring> = clip.rings.iter().filter(|r| solid(r) && meets(r, sb)).cloned().collect();
-    let (s_rings, c_rings) = (oriented(&Region { rings: near }), oriented(&Region { rings: c_near }));
+    let (s_rings, c_rings, far) = rings_that_meet(subject, clip, (sb, cb), eps);
     if s_rings.is_empty() || c_rings.is_empty() {
         return Ok(Clipped {
             inside: Region::default(),
@@ -258,65 +246,107 @@ pub fn clip(subject: &Region, clip: &Region) -> Result<Clipped, ClipError> {
         });
     }
     let mut verts = Vertices { pts: Vec::new(), grid: HashMap::default(), eps };
-    let edges_of = |rings: &[Ring], verts: &mut Vertices| -> Vec<Edge> {
-        let mut out = Vec::new();
-        for ring in rings {
-            let ids: Vec<u32> = ring.iter().map(|&p| verts.id(p)).collect();
-            for k in 0..ids.len() {
-                let (a, b) = (ids[k], ids[(k + 1) % ids.len()]);
-                if a != b {
-                    out.push(Edge { a, b, splits: Vec::new() });
-                }
-            }
-        }
-        out
-    };
     let se = edges_of(&s_rings, &mut verts);
     let ce = edges_of(&c_rings, &mut verts);
+    let (se, ce) = split_where_they_meet(se, ce, &mut verts);
+    let (sp, cp) = (pieces(&se), pieces(&ce));
+    let (inside, outside) = classify(&verts.pts, &sp, &cp);
+    // Step 3: trace.
+    let mut outside = trace(&verts.pts, &outside, eps)?;
+    outside.rings.extend(far);
+    Ok(Clipped { inside: trace(&verts.pts, &inside, eps)?, outside })
+}
 
-    // Step 1: split both regions' edges wherever they meet, each other's and their own (a
-    // ring cut by Sutherland-Hodgman can run back along itself: a zero-width bridge). Only
-    // edges whose boxes overlap can meet: a sweep along x finds them.
-    let n_s = se.len();
-    let mut all: Vec<Edge> = se.into_iter().chain(ce).collect();
-    for (i, j) in overlapping_pairs(&all, &verts.pts, eps) {
-        let (head, tail) = all.split_at_mut(j);
-        split_pair(&mut head[i], &mut tail[0], &mut verts);
-    }
-    let ce = all.split_off(n_s);
-    let se = all;
-    // Sub-edges, with pieces that run both ways within one region (bridges) cancelled.
-    let pieces = |edges: &[Edge]| -> Vec<(u32, u32)> {
-        let mut count: HashMap<(u32, u32), i32> = HashMap::default();
-        let mut order = Vec::new();
-        for e in edges {
-            let mut s = e.splits.clone();
-            s.sort_by(|x, y| x.0.total_cmp(&y.0));
-            let mut prev = e.a;
-            for (_, v) in s.into_iter().chain([(1.0, e.b)]) {
-                if v != prev {
-                    let key = (prev.min(v), prev.max(v));
-                    let c = count.entry(key).or_insert_with(|| {
-                        order.push(key);
-                        0
-                    });
-                    *c += if prev < v { 1 } else { -1 };
-                    prev = v;
-                }
+/// The rings that can matter, oriented: a ring whose box misses the other region's box
+/// cannot change anything inside that box (by the even-odd rule), so subject rings there
+/// pass to the outside part untouched (returned third) and clip rings there are dropped.
+/// Rings with no area (slivers, lines walked there and back) bound nothing and are dropped
+/// too.
+fn rings_that_meet(
+    subject: &Region,
+    clip: &Region,
+    (sb, cb): ((DVec2, DVec2), (DVec2, DVec2)),
+    eps: f64,
+) -> (Vec<Ring>, Vec<Ring>, Vec<Ring>) {
+    let ring_box =
+        |r: &Ring| r.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let meets = |r: &Ring, b: (DVec2, DVec2)| {
+        let (lo, hi) = ring_box(r);
+        lo.x <= b.1.x + eps && b.0.x <= hi.x + eps && lo.y <= b.1.y + eps && b.0.y <= hi.y + eps
+    };
+    let solid = |r: &Ring| signed_area(r).abs() > eps * eps;
+    let (near, far): (Vec<Ring>, Vec<Ring>) =
+        subject.rings.iter().filter(|r| solid(r)).cloned().partition(|r| meets(r, cb));
+    let c_near: Vec<Ring> = clip.rings.iter().filter(|r| solid(r) && meets(r, sb)).cloned().collect();
+    (oriented(&Region { rings: near }), oriented(&Region { rings: c_near }), far)
+}
+
+/// The edges of `rings`, between shared vertex ids.
+fn edges_of(rings: &[Ring], verts: &mut Vertices) -> Vec<Edge> {
+    let mut out = Vec::new();
+    for ring in rings {
+        let ids: Vec<u32> = ring.iter().map(|&p| verts.id(p)).collect();
+        for k in 0..ids.len() {
+            let (a, b) = (ids[k], ids[(k + 1) % ids.len()]);
+            if a != b {
+                out.push(Edge { a, b, splits: Vec::new() });
             }
         }
-        let mut out = Vec::new();
-        for key in order {
-            let c = count[&key];
-            let e = if c > 0 { key } else { (key.1, key.0) };
-            out.extend(std::iter::repeat_n(e, c.unsigned_abs() as usize));
-        }
-        out
-    };
-    let (sp, cp) = (pieces(&se), pieces(&ce));
+    }
+    out
+}
 
-    // Step 2: classify.
-    let pts = &verts.pts;
+/// Step 1: split both regions' edges wherever they meet, each other's and their own (a ring
+/// cut by Sutherland-Hodgman can run back along itself: a zero-width bridge). Only edges
+/// whose boxes overlap can meet: a sweep along x finds them.
+fn split_where_they_meet(se: Vec<Edge>, ce: Vec<Edge>, verts: &mut Vertices) -> (Vec<Edge>, Vec<Edge>) {
+    let n_s = se.len();
+    let mut all: Vec<Edge> = se.into_iter().chain(ce).collect();
+    for (i, j) in overlapping_pairs(&all, &verts.pts, verts.eps) {
+        let (head, tail) = all.split_at_mut(j);
+        split_pair(&mut head[i], &mut tail[0], verts);
+    }
+    let ce = all.split_off(n_s);
+    (all, ce)
+}
+
+/// The sub-edges of split edges, with pieces that run both ways within one region (bridges)
+/// cancelled.
+fn pieces(edges: &[Edge]) -> Vec<(u32, u32)> {
+    let mut count: HashMap<(u32, u32), i32> = HashMap::default();
+    let mut order = Vec::new();
+    for e in edges {
+        let mut s = e.splits.clone();
+        s.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let mut prev = e.a;
+        for (_, v) in s.into_iter().chain([(1.0, e.b)]) {
+            if v != prev {
+                let key = (prev.min(v), prev.max(v));
+                let c = count.entry(key).or_insert_with(|| {
+                    order.push(key);
+                    0
+                });
+                *c += if prev < v { 1 } else { -1 };
+                prev = v;
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for key in order {
+        let c = count[&key];
+        let e = if c > 0 { key } else { (key.1, key.0) };
+        out.extend(std::iter::repeat_n(e, c.unsigned_abs() as usize));
+    }
+    out
+}
+
+/// A piece of an edge between two vertex ids, directed.
+type Piece = (u32, u32);
+
+/// Step 2: each piece of the subject is inside or outside the clip region (a shared piece
+/// by its direction, any other by its midpoint); each piece of the clip region inside the
+/// subject bounds the inside part, and, reversed, the outside part.
+fn classify(pts: &[DVec2], sp: &[Piece], cp: &[Piece]) -> (Vec<Piece>, Vec<Piece>) {
     let mid = |&(a, b): &(u32, u32)| (pts[a as usize] + pts[b as usize]) * 0.5;
     // Point-in-region by the even-odd rule over a region's pieces (bridges cancelled).
     let contains = |edges: &[(u32, u32)], p: DVec2| {
@@ -333,31 +363,27 @@ pub fn clip(subject: &Region, clip: &Region) -> Result<Clipped, ClipError> {
     let c_dir: HashMap<(u32, u32), ()> = cp.iter().map(|&e| (e, ())).collect();
     let s_dir: HashMap<(u32, u32), ()> = sp.iter().map(|&e| (e, ())).collect();
     let (mut inside, mut outside) = (Vec::new(), Vec::new());
-    for e in &sp {
+    for e in sp {
         if c_dir.contains_key(e) {
             inside.push(*e); // shared, same way
         } else if c_dir.contains_key(&(e.1, e.0)) {
             outside.push(*e); // shared, opposite ways
-        } else if contains(&cp, mid(e)) {
+        } else if contains(cp, mid(e)) {
             inside.push(*e);
         } else {
             outside.push(*e);
         }
     }
-    for e in &cp {
+    for e in cp {
         if s_dir.contains_key(e) || s_dir.contains_key(&(e.1, e.0)) {
             continue; // shared: taken from the subject above
         }
-        if contains(&sp, mid(e)) {
+        if contains(sp, mid(e)) {
             inside.push(*e);
             outside.push((e.1, e.0));
         }
     }
-
-    // Step 3: trace.
-    let mut outside = trace(pts, &outside, eps)?;
-    outside.rings.extend(far);
-    Ok(Clipped { inside: trace(pts, &inside, eps)?, outside })
+    (inside, outside)
 }
 
 /// The pairs `(i, j)`, `i < j`, of edges whose bounding boxes (grown by `eps`) overlap: a

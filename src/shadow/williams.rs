@@ -569,6 +569,8 @@ const CUBE: [(DVec3, DVec3); 6] = [
 ];
 
 impl LightMaps {
+    /// Pass 1 for one light sample: one orthographic map for a directional light, one
+    /// perspective map for a point light whose window is narrow enough, else a cube of six.
     fn new(ctx: &ShadowContext, sample: LightSample, o: &WilliamsOptions, counters: &mut Counters) -> LightMaps {
         let (lo, hi) = ctx.scene.bounds().unwrap_or((DVec3::ZERO, DVec3::ONE));
         let corners: Vec<DVec3> = (0..8)
@@ -587,57 +589,15 @@ impl LightMaps {
         // is seen. Depth still spans the whole scene.
         let seen = if o.fit_to_view { visible_points(ctx, ctx.pools.points.take()) } else { Vec::new() };
         let covered = if seen.is_empty() { &corners } else { &seen };
-        let near = 1e-6 * ctx.extent;
-        let pinhole = |eye: DVec3, axis: DVec3, up: DVec3, fov: f64| {
-            let up = if axis.cross(up).length() < 1e-6 { axis.any_orthonormal_vector() } else { up };
-            let cam = Camera {
-                eye,
-                target: eye + axis,
-                up,
-                fov_y: fov,
-                width: o.map_size,
-                height: o.map_size,
-                near,
-                far: None,
-            };
-            Projection::Perspective(View::new(&cam))
-        };
-        // The map's rows are turned to run along the screen's rows (the eye's right vector
-        // seen from the light), so that pass 2, walking a screen row, walks along map rows
-        // and reads texels that share cache lines.
-        let across = |axis: DVec3| {
-            let r = ctx.view.r - axis * axis.dot(ctx.view.r);
-            if r.length() < 1e-6 {
-                axis.any_orthonormal_vector()
-            } else {
-                r.normalize()
-            }
-        };
         let maps = match sample {
             LightSample::Directional(d) => {
                 counters.add("maps_ortho", 1);
-                let u = across(d);
-                let v = d.cross(u);
-                let range = |pts: &[DVec3], a: DVec3| {
-                    pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| (l.min(c.dot(a)), h.max(c.dot(a))))
-                };
-                let ((u0, u1), (v0, v1), (s0, _)) = (range(covered, u), range(covered, v), range(&corners, d));
-                let side = (u1 - u0).max(v1 - v0) * 1.01 + 1e-12;
-                let proj = Projection::Ortho {
-                    u,
-                    v,
-                    d,
-                    u0: u0 - 0.005 * side,
-                    v0: v1 + 0.005 * side,
-                    s0: s0 - 0.01 * side,
-                    texel: side / o.map_size as f64,
-                };
+                let proj = orthographic(across(ctx.view, d), d, covered, &corners, o.map_size);
                 LightMaps::Single(Box::new(DepthMap::render(ctx, proj, sample, o)))
             }
             LightSample::Point(s) => {
                 let (clo, chi) = covered.iter().fold((covered[0], covered[0]), |(l, h), &p| (l.min(p), h.max(p)));
-                let center = (clo + chi) * 0.5;
-                let axis = (center - s).normalize_or(DVec3::NEG_Y);
+                let axis = ((clo + chi) * 0.5 - s).normalize_or(DVec3::NEG_Y);
                 // The widest angle from the axis: the smallest cosine, one arccosine.
                 let half = covered
                     .iter()
@@ -645,14 +605,17 @@ impl LightMaps {
                     .fold(1.0, f64::min)
                     .clamp(-1.0, 1.0)
                     .acos();
+                let near = 1e-6 * ctx.extent;
                 if half < 80f64.to_radians() {
                     counters.add("maps_perspective", 1);
-                    let proj = pinhole(s, axis, across(axis).cross(axis), (2.0 * half).to_degrees() * 1.02 + 0.1);
+                    let fov = (2.0 * half).to_degrees() * 1.02 + 0.1;
+                    let proj = pinhole(s, axis, across(ctx.view, axis).cross(axis), fov, o.map_size, near);
                     LightMaps::Single(Box::new(DepthMap::render(ctx, proj, sample, o)))
                 } else {
                     counters.add("maps_cube_faces", 6);
-                    let faces = CUBE.map(|(axis, up)| DepthMap::render(ctx, pinhole(s, axis, up, 90.0), sample, o));
-                    LightMaps::Cube(Box::new(faces), s)
+                    let face =
+                        |(axis, up)| DepthMap::render(ctx, pinhole(s, axis, up, 90.0, o.map_size, near), sample, o);
+                    LightMaps::Cube(Box::new(CUBE.map(face)), s)
                 }
             }
         };
@@ -700,6 +663,46 @@ impl LightMaps {
                 }
             }
         }
+    }
+}
+
+/// The direction across a map whose axis is `axis`: the eye's right vector seen from the
+/// light. The map's rows are turned to run along the screen's rows, so that pass 2, walking a
+/// screen row, walks along map rows and reads texels that share cache lines.
+fn across(view: &View, axis: DVec3) -> DVec3 {
+    let r = view.r - axis * axis.dot(view.r);
+    if r.length() < 1e-6 {
+        axis.any_orthonormal_vector()
+    } else {
+        r.normalize()
+    }
+}
+
+/// A square map of `size` texels looking from `eye` along `axis` with a field of `fov`
+/// degrees.
+fn pinhole(eye: DVec3, axis: DVec3, up: DVec3, fov: f64, size: u32, near: f64) -> Projection {
+    let up = if axis.cross(up).length() < 1e-6 { axis.any_orthonormal_vector() } else { up };
+    let cam = Camera { eye, target: eye + axis, up, fov_y: fov, width: size, height: size, near, far: None };
+    Projection::Perspective(View::new(&cam))
+}
+
+/// The orthographic map along `d` (rows along `u`) whose window covers `covered` and whose
+/// depth starts before every corner of the scene.
+fn orthographic(u: DVec3, d: DVec3, covered: &[DVec3], corners: &[DVec3], size: u32) -> Projection {
+    let v = d.cross(u);
+    let range = |pts: &[DVec3], a: DVec3| {
+        pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| (l.min(c.dot(a)), h.max(c.dot(a))))
+    };
+    let ((u0, u1), (v0, v1), (s0, _)) = (range(covered, u), range(covered, v), range(corners, d));
+    let side = (u1 - u0).max(v1 - v0) * 1.01 + 1e-12;
+    Projection::Ortho {
+        u,
+        v,
+        d,
+        u0: u0 - 0.005 * side,
+        v0: v1 + 0.005 * side,
+        s0: s0 - 0.01 * side,
+        texel: side / size as f64,
     }
 }
 
