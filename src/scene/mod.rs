@@ -3,6 +3,7 @@
 
 mod load;
 mod obj;
+pub(crate) use obj::ObjText;
 mod write;
 
 pub use obj::parse_obj;

@@ -1,4 +1,4 @@
-//! Wavefront OBJ reading: `v`, `vn`, `vt` and `f` (forms `v`, `v/vt`, `v//vn`, `v/vt/vn`,
+//! Wavefront OBJ reading (and writing, [`ObjText`]): `v`, `vn`, `vt` and `f` (forms `v`, `v/vt`, `v//vn`, `v/vt/vn`,
 //! negative indices), faces kept as polygons. Every other statement is ignored.
 //!
 //! Written by hand rather than with an OBJ crate because the contract needs what those crates
@@ -8,6 +8,7 @@
 use super::{Face, Mesh};
 use crate::error::{Error, FileLoc, Result};
 use glam::DVec3;
+use std::fmt::Write as _;
 use std::path::Path;
 
 /// Parses OBJ text; `file` names it in errors.
@@ -105,6 +106,55 @@ fn index(word: &str, count: usize, what: &str, loc: &impl Fn() -> FileLoc) -> Re
         return Err(Error::input(loc(), format!("{what} index {i} out of range ({count} defined so far)")));
     }
     Ok(resolved as u32)
+}
+
+/// Wavefront OBJ text, written: vertices, normals, groups and faces with 1-based indices.
+/// The one writer that the scene writer's meshes and the shadow database's export share.
+#[derive(Default)]
+pub(crate) struct ObjText {
+    text: String,
+    vertices: usize,
+}
+
+impl ObjText {
+    /// A file that starts with `header` lines (comments, `#` included).
+    pub(crate) fn with_header(header: &str) -> ObjText {
+        ObjText { text: header.to_owned(), vertices: 0 }
+    }
+
+    /// A `v` line; returns its 1-based index.
+    pub(crate) fn vertex(&mut self, p: DVec3) -> usize {
+        let _ = writeln!(self.text, "v {:?} {:?} {:?}", p.x, p.y, p.z);
+        self.vertices += 1;
+        self.vertices
+    }
+
+    /// A `vn` line.
+    pub(crate) fn normal(&mut self, n: DVec3) {
+        let _ = writeln!(self.text, "vn {:?} {:?} {:?}", n.x, n.y, n.z);
+    }
+
+    /// A `g` line.
+    pub(crate) fn group(&mut self, name: &str) {
+        let _ = writeln!(self.text, "g {name}");
+    }
+
+    /// An `f` line of 1-based vertex indices, each with its 1-based normal index if any.
+    pub(crate) fn face(&mut self, corners: impl IntoIterator<Item = (usize, Option<usize>)>) {
+        self.text.push('f');
+        for (v, n) in corners {
+            let _ = match n {
+                Some(n) => write!(self.text, " {v}//{n}"),
+                None => write!(self.text, " {v}"),
+            };
+        }
+        self.text.push('\n');
+    }
+
+    /// Writes the text to `path` in one call.
+    pub(crate) fn save(self, path: &Path) -> Result<()> {
+        std::fs::write(path, self.text).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+    }
 }
 
 #[cfg(test)]

@@ -29,13 +29,12 @@ use super::{ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::weiler_atherton::{clip, ClipError, Region};
 use crate::geometry::{clip_polygon, even_odd, Plane};
-use crate::scene::{LightSample, Scene};
+use crate::scene::{LightSample, ObjText, Scene};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use std::collections::HashMap;
-use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
@@ -478,22 +477,17 @@ impl ShadowDatabase {
     /// light sample and the face id of its source polygon (`g sample<s>_face<id>`); holes are
     /// separate faces of the same group.
     pub fn write_obj(&self, scene: &Scene, path: &Path) -> Result<()> {
-        let mut out = String::from("# umbra: Atherton-Weiler-Greenberg lit detail polygons\n");
-        let mut next = 1;
+        let mut obj = ObjText::with_header("# umbra: Atherton-Weiler-Greenberg lit detail polygons\n");
         for (s, polys) in self.samples.iter().enumerate() {
             for d in polys {
-                let _ = writeln!(out, "g sample{s}_face{}", scene.polygons[d.source as usize].face);
+                obj.group(&format!("sample{s}_face{}", scene.polygons[d.source as usize].face));
                 for ring in &d.rings {
-                    for v in ring {
-                        let _ = writeln!(out, "v {:?} {:?} {:?}", v.x, v.y, v.z);
-                    }
-                    let ids: Vec<String> = (next..next + ring.len()).map(|i| i.to_string()).collect();
-                    let _ = writeln!(out, "f {}", ids.join(" "));
-                    next += ring.len();
+                    let ids: Vec<usize> = ring.iter().map(|&v| obj.vertex(v)).collect();
+                    obj.face(ids.into_iter().map(|v| (v, None)));
                 }
             }
         }
-        std::fs::write(path, out).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+        obj.save(path)
     }
 }
 
