@@ -70,6 +70,7 @@ pub use error::{Error, FileLoc, Result};
 pub use frame::{check_gamma, Frame, PixelCounters, BACKGROUND, GAMMA_RANGE};
 /// The vector types the API takes and gives (points, directions, colours).
 pub use glam;
+pub use progress::{Progress, ProgressFn};
 pub use reflection::ReflectionMethod;
 pub use render::{render, RenderOptions, Rendered, Renderer};
 pub use scene::Scene;

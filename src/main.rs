@@ -1,14 +1,20 @@
 //! The `umbra` command line: a thin layer over the library.
 
+mod cli {
+    pub mod progress;
+}
+
 use clap::{Parser, Subcommand, ValueEnum};
+use cli::progress::TerminalBar;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
 use umbra::shadow::Counting;
 use umbra::shadow::{BouknightKelleyOptions, ShadowFilter, VolumeOptions, WilliamsOptions};
 use umbra::study::compare::{compare, CompareOptions};
 use umbra::study::scale::{scale, ScaleOptions, Sweep};
 use umbra::ReflectionMethod;
-use umbra::{generate, render, Error, RenderOptions, Scene, ShadowMethod, VisibilityMethod};
+use umbra::{generate, Error, RenderOptions, Renderer, Scene, ShadowMethod, VisibilityMethod};
 
 #[derive(Parser)]
 #[command(
@@ -492,12 +498,16 @@ fn render_command(a: RenderArgs) -> umbra::Result<()> {
     let opts = RenderOptions {
         visibility: a.visibility,
         shadows: a.shadow.configure(a.shadows.clone()),
-        progress: true,
         pixel_counters: a.aov.is_some(),
         reflection: a.reflection,
         outlines: a.debug.is_some(),
     };
-    let out = render(&scene, &opts)?;
+    let bar = Arc::new(TerminalBar::new("{msg:40} {bar:30} {pos}/{len} lines {elapsed}"));
+    let shown = bar.clone();
+    let mut renderer = Renderer::new().with_progress(move |p| shown.report(p));
+    let out = renderer.render(&scene, &opts);
+    bar.finish();
+    let out = out?;
     let mut img = out.frame.color_image(a.gamma);
     if a.debug.is_some() {
         umbra::Frame::draw_outlines(&mut img, &out.outlines, [255, 40, 200]);
@@ -526,9 +536,11 @@ fn compare_command(a: CompareArgs) -> umbra::Result<()> {
         warmup: a.warmup,
         runs: a.runs,
         out: a.out.clone(),
-        progress: true,
     };
-    let report = compare(&scene, &scene_name(&a.scene), &opts)?;
+    let bar = TerminalBar::new("{msg:32} {bar:40} {pos}/{len} renders {elapsed}");
+    let report = compare(&scene, &scene_name(&a.scene), &opts, |p| bar.report(p));
+    bar.finish();
+    let report = report?;
     let mut table = String::new();
     for r in &report.results {
         table += &format!(

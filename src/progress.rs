@@ -1,99 +1,61 @@
-//! Progress bars on standard error for long work, drawn with `indicatif` when the `cli`
-//! feature is on (the default) and only on a terminal; without the feature they draw nothing,
-//! so a library build needs no terminal crate.
+//! Progress of long work, reported to the program that asked for it through a callback. The
+//! library draws nothing; the command line draws a bar on a terminal.
 
-/// A bar of `total` steps of `unit` that appears after a second of work, on a terminal.
-pub(crate) struct Bar {
-    #[cfg(feature = "cli")]
-    bar: Option<indicatif::ProgressBar>,
-    #[cfg(feature = "cli")]
-    template: &'static str,
-    enabled: bool,
-    start: std::time::Instant,
-    done: u64,
-    total: u64,
-    message: String,
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+/// Where a piece of work is.
+#[derive(Debug, Clone, Copy)]
+pub struct Progress<'a> {
+    /// What is being done now ("visibility (scanline)", "zbuffer + crow").
+    pub phase: &'a str,
+    /// Steps done.
+    pub done: u64,
+    /// Steps in all.
+    pub total: u64,
+    /// What a step is ("lines" of a frame, "renders" of a comparison).
+    pub unit: &'a str,
 }
 
-impl Bar {
-    /// A bar for `total` steps; `template` is indicatif's (for example
-    /// `"{msg} {bar:40} {pos}/{len} lines {elapsed}"`).
-    pub(crate) fn new(enabled: bool, total: u64, #[allow(unused_variables)] template: &'static str) -> Self {
-        use std::io::IsTerminal;
-        Bar {
-            #[cfg(feature = "cli")]
-            bar: None,
-            #[cfg(feature = "cli")]
-            template,
-            enabled: enabled && std::io::stderr().is_terminal(),
-            start: std::time::Instant::now(),
-            done: 0,
-            total,
-            message: String::new(),
-        }
+/// A program's progress callback: called when a phase begins and as steps are done, from
+/// any thread.
+pub type ProgressFn = dyn Fn(Progress<'_>) + Send + Sync;
+
+/// Reports one piece of work to a callback, when there is one.
+pub(crate) struct Reporter<'f> {
+    to: Option<&'f (dyn Fn(Progress<'_>) + Send + Sync + 'f)>,
+    phase: Mutex<String>,
+    done: AtomicU64,
+    total: u64,
+    unit: &'static str,
+}
+
+impl<'f> Reporter<'f> {
+    /// Work of `total` steps of `unit`, reported to `to`.
+    pub(crate) fn new(
+        to: Option<&'f (dyn Fn(Progress<'_>) + Send + Sync + 'f)>,
+        total: u64,
+        unit: &'static str,
+    ) -> Self {
+        Reporter { to, phase: Mutex::new(String::new()), done: AtomicU64::new(0), total, unit }
     }
 
-    /// What is being done now.
-    pub(crate) fn set_message(&mut self, message: impl Into<String>) {
-        self.message = message.into();
-        #[cfg(feature = "cli")]
-        if let Some(bar) = &self.bar {
-            bar.set_message(self.message.clone());
-        }
-    }
-
-    /// A phase of the work begins: the bar shows its name and, from now on, ticks on its own
-    /// (so a long phase with no steps, such as a shadow stage's preparation, is not silent).
-    pub(crate) fn phase(&mut self, name: impl Into<String>) {
-        self.set_message(name);
-        #[cfg(feature = "cli")]
-        if self.bar.is_none() && self.enabled {
-            let target = indicatif::ProgressDrawTarget::stderr();
-            let bar = indicatif::ProgressBar::with_draw_target(Some(self.total), target);
-            if let Ok(style) = indicatif::ProgressStyle::with_template(self.template) {
-                bar.set_style(style);
-            }
-            bar.set_message(self.message.clone());
-            bar.enable_steady_tick(std::time::Duration::from_millis(500));
-            self.bar = Some(bar);
+    /// A phase of the work begins.
+    pub(crate) fn phase(&self, name: impl Into<String>) {
+        let Some(to) = self.to else { return };
+        let name = name.into();
+        to(Progress { phase: &name, done: self.done.load(Ordering::Relaxed), total: self.total, unit: self.unit });
+        if let Ok(mut phase) = self.phase.lock() {
+            *phase = name;
         }
     }
 
     /// `n` more steps done.
-    pub(crate) fn advance(&mut self, n: u64) {
-        self.done += n;
-        #[cfg(feature = "cli")]
-        {
-            let due = self.start.elapsed() > std::time::Duration::from_secs(1);
-            if self.bar.is_none() && self.enabled && due {
-                let target = indicatif::ProgressDrawTarget::stderr();
-                let bar = indicatif::ProgressBar::with_draw_target(Some(self.total), target);
-                if let Ok(style) = indicatif::ProgressStyle::with_template(self.template) {
-                    bar.set_style(style);
-                }
-                bar.set_message(self.message.clone());
-                self.bar = Some(bar);
-            }
-            if let Some(bar) = &self.bar {
-                // Once steps are being done, their rate gives an estimate of what is left.
-                if bar.position() == 0 && self.done > 0 {
-                    let estimate = format!("{}, about {{eta}} left", self.template);
-                    if let Ok(style) = indicatif::ProgressStyle::with_template(&estimate) {
-                        bar.set_style(style);
-                    }
-                }
-                bar.set_position(self.done);
-            }
-        }
-        #[cfg(not(feature = "cli"))]
-        let _ = (self.enabled, self.start, self.total);
-    }
-
-    /// Clears the bar.
-    pub(crate) fn finish(&self) {
-        #[cfg(feature = "cli")]
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
+    pub(crate) fn advance(&self, n: u64) {
+        let Some(to) = self.to else { return };
+        let done = self.done.fetch_add(n, Ordering::Relaxed) + n;
+        if let Ok(phase) = self.phase.lock() {
+            to(Progress { phase: &phase, done, total: self.total, unit: self.unit });
         }
     }
 }

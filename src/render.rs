@@ -7,6 +7,7 @@
 
 use crate::error::Result;
 use crate::frame::{Frame, PixelCounters};
+use crate::progress::{Progress, ProgressFn, Reporter};
 use crate::reflection::ReflectionMethod;
 use crate::scene::Scene;
 use crate::shading::{RunShading, Shader};
@@ -16,7 +17,7 @@ use crate::view::View;
 use crate::visibility::{FrameRuns, VisibilityMethod};
 use glam::Vec3;
 use rayon::prelude::*;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// What to render with.
@@ -26,9 +27,6 @@ pub struct RenderOptions {
     pub visibility: VisibilityMethod,
     /// The shadow stage, with its settings.
     pub shadows: ShadowMethod,
-    /// Show a progress bar on stderr when the render takes more than a second and stderr is
-    /// a terminal.
-    pub progress: bool,
     /// Collect per-pixel counters into [`Frame::counters`].
     pub pixel_counters: bool,
     /// How mirrors are rendered.
@@ -44,7 +42,6 @@ impl Default for RenderOptions {
         RenderOptions {
             visibility: VisibilityMethod::Scanline,
             shadows: ShadowMethod::DEFAULT,
-            progress: false,
             outlines: false,
             pixel_counters: false,
             reflection: crate::reflection::ReflectionMethod::default(),
@@ -120,6 +117,7 @@ fn check_frame_memory(scene: &Scene, opts: &RenderOptions) -> Result<()> {
 pub struct Renderer {
     pools: crate::pool::Pools,
     awg_database: Option<Arc<Vec<ShadowDatabase>>>,
+    progress: Option<Arc<ProgressFn>>,
     last: Option<Rendered>,
 }
 
@@ -145,8 +143,28 @@ impl Renderer {
         self
     }
 
+    /// Reports each frame's progress to `report` (the phase, and lines shaded of all):
+    /// what the command line draws as a progress bar.
+    ///
+    /// ```
+    /// use umbra::{generate, RenderOptions, Renderer};
+    /// use std::sync::atomic::{AtomicU64, Ordering};
+    /// use std::sync::Arc;
+    ///
+    /// let lines = Arc::new(AtomicU64::new(0));
+    /// let seen = lines.clone();
+    /// let mut renderer = Renderer::new().with_progress(move |p| seen.store(p.done, Ordering::Relaxed));
+    /// renderer.render(&generate::cubes(2, false, 64, 48)?, &RenderOptions::default())?;
+    /// assert_eq!(lines.load(Ordering::Relaxed), 48);
+    /// # Ok::<(), umbra::Error>(())
+    /// ```
+    pub fn with_progress(mut self, report: impl Fn(Progress<'_>) + Send + Sync + 'static) -> Renderer {
+        self.progress = Some(Arc::new(report));
+        self
+    }
+
     fn kept(&self) -> Kept<'_> {
-        Kept { pools: &self.pools, awg_database: self.awg_database.clone() }
+        Kept { pools: &self.pools, awg_database: self.awg_database.clone(), progress: self.progress.as_deref() }
     }
 
     /// The last frame rendered, to keep.
@@ -162,13 +180,14 @@ impl Renderer {
 
 /// Renders `scene` with the chosen stages (a fresh [`Renderer`]'s one frame).
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
-    render_with(scene, opts, &Kept { pools: &Default::default(), awg_database: None }, None)
+    render_with(scene, opts, &Kept { pools: &Default::default(), awg_database: None, progress: None }, None)
 }
 
 /// What a renderer keeps between frames and hands to the passes.
 struct Kept<'r> {
     pools: &'r crate::pool::Pools,
     awg_database: Option<Arc<Vec<ShadowDatabase>>>,
+    progress: Option<&'r ProgressFn>,
 }
 
 /// The frame pass, then the reflection pass over it, taking frame-sized buffers from `pools`
@@ -178,12 +197,12 @@ fn render_with(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<F
     if opts.reflection != ReflectionMethod::Off {
         let t = Instant::now();
         // What a mirror shows is a frame of its own, with one level of reflection.
-        let inner =
-            RenderOptions { reflection: ReflectionMethod::Off, progress: false, pixel_counters: false, ..opts.clone() };
+        let inner = RenderOptions { reflection: ReflectionMethod::Off, pixel_counters: false, ..opts.clone() };
         let mirror_pass = |mirrored: &Scene| {
             // The mirrored scene has other polygons and lights: a database built beforehand
             // for the scene does not apply.
-            let (mut seen, _) = frame_pass(mirrored, &inner, &Kept { awg_database: None, ..*kept }, None)?;
+            let (mut seen, _) =
+                frame_pass(mirrored, &inner, &Kept { awg_database: None, progress: None, ..*kept }, None)?;
             saturate(&mut seen.frame.color);
             Ok(seen.frame)
         };
@@ -212,8 +231,7 @@ fn frame_pass(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<Fr
         ..Stats::default()
     };
     let view = View::new(&scene.camera);
-    let mut bar =
-        crate::progress::Bar::new(opts.progress, view.height as u64, "{msg:40} {bar:30} {pos}/{len} lines {elapsed}");
+    let bar = Reporter::new(kept.progress, view.height as u64, "lines");
 
     let t = Instant::now();
     bar.phase("view: clipping and projecting");
@@ -244,8 +262,7 @@ fn frame_pass(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<Fr
     frame.light_samples = ctx.samples.iter().map(|s| s.len() as u32).collect();
     frame.counters = pixel_counters;
     bar.phase("shadow walk and shading");
-    let bands = shade_frame(&ctx, &*shadows, &mut frame, &Mutex::new(&mut bar));
-    bar.finish();
+    let bands = shade_frame(&ctx, &*shadows, &mut frame, &bar);
     // The bands ran on several threads: the wall-clock time of the pass is split between
     // the shadow walk and the shading in the proportion of their summed band times.
     let pass = ms(t.elapsed());
@@ -298,7 +315,7 @@ fn shade_frame(
     ctx: &ShadowContext,
     shadows: &dyn crate::shadow::ShadowStage,
     frame: &mut Frame,
-    progress: &Mutex<&mut crate::progress::Bar>,
+    progress: &Reporter,
 ) -> Vec<BandWork> {
     let shader = Shader::new(ctx.scene, ctx.view, &ctx.samples);
     let w = frame.width;
@@ -323,9 +340,7 @@ fn shade_frame(
         .map(|job| {
             let lines = job.y0..job.y0 + (job.id.len() / w as usize) as u32;
             let work = shade_band(ctx, shadows, &shader, job);
-            if let Ok(mut p) = progress.lock() {
-                p.advance(lines.len() as u64);
-            }
+            progress.advance(lines.len() as u64);
             work
         })
         .collect()

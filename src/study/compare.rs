@@ -33,8 +33,6 @@ pub struct CompareOptions {
     pub runs: usize,
     /// Output folder.
     pub out: PathBuf,
-    /// Show a progress bar on stderr.
-    pub progress: bool,
 }
 
 impl Default for CompareOptions {
@@ -45,7 +43,6 @@ impl Default for CompareOptions {
             warmup: 1,
             runs: 3,
             out: PathBuf::from("compare"),
-            progress: false,
         }
     }
 }
@@ -133,8 +130,14 @@ pub fn diff(reference: &Frame, got: &Frame) -> (usize, usize, image::RgbImage) {
     (interior, wrong, img)
 }
 
-/// Runs the comparison and writes the report into `opts.out`.
-pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Report> {
+/// Runs the comparison and writes the report into `opts.out`, telling `progress` which
+/// method is being measured and how many renders are done.
+pub fn compare(
+    scene: &Scene,
+    name: &str,
+    opts: &CompareOptions,
+    progress: impl Fn(crate::Progress<'_>) + Send + Sync,
+) -> Result<Report> {
     let img_dir = opts.out.join("img");
     std::fs::create_dir_all(&img_dir).map_err(|e| Error::Io { path: img_dir.clone(), source: e })?;
     let save = |img: image::RgbImage, file: &str| -> Result<String> {
@@ -150,11 +153,11 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
     let reference = render(scene, &reference_opts)?.frame;
     let reference_image = save(reference.color_image(None), "reference.png")?;
     let total = (opts.visibility.len() * opts.shadows.len() * opts.runs.max(1)) as u64;
-    let mut bar = crate::progress::Bar::new(opts.progress, total, "{msg:32} {bar:40} {pos}/{len} renders {elapsed}");
+    let bar = crate::progress::Reporter::new(Some(&progress), total, "renders");
     let mut results = Vec::new();
     for &v in &opts.visibility {
         for s in &opts.shadows {
-            bar.set_message(format!("{v} + {s}"));
+            bar.phase(format!("{v} + {s}"));
             let id = format!("{v}-{s}");
             let ropts = RenderOptions { visibility: v, shadows: s.clone(), ..RenderOptions::default() };
             let (status, measured) = match measure(scene, &ropts, opts.warmup, opts.runs) {
@@ -208,7 +211,6 @@ pub fn compare(scene: &Scene, name: &str, opts: &CompareOptions) -> Result<Repor
             });
         }
     }
-    bar.finish();
     let report = Report {
         about: super::About::now(format!(
             "warmup {}, runs {}, shadow stages {:?}",

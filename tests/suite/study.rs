@@ -25,7 +25,7 @@ fn compare_reports_every_method_and_a_valid_page() {
     }
     let out = tmp("compare");
     let opts = CompareOptions { runs: 1, out: out.clone(), ..CompareOptions::default() };
-    let report = compare(&scene, "lights", &opts).unwrap();
+    let report = compare(&scene, "lights", &opts, |_| {}).unwrap();
     assert_eq!(report.results.len(), umbra::VisibilityMethod::ALL.len() * ShadowMethod::ALL.len());
     for r in &report.results {
         let m: ShadowMethod = r.shadows.parse().unwrap();
