@@ -25,9 +25,9 @@
 //! takes it as not in front, z-fail as behind, as a depth test `<` would. A per-polygon
 //! volume never counts for its own face.
 
-use super::volumes::{Adjacency, Counting, ScreenVolumes, NONE};
+use super::volumes::{Adjacency, Counting, ScreenVolumes};
 use super::{CountAdd, Decision, Detail, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
-use crate::scan::{boundary, ActiveEdges, EdgeTable};
+use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
 use crate::visibility::Run;
@@ -80,8 +80,7 @@ impl ShadowStage for Crow<'_> {
                     aet: ActiveEdges::new(&s.table, 0..h),
                     xs: Vec::new(),
                     cursor: 0,
-                    open: vec![NONE; s.volumes.polys.len()],
-                    open_list: Vec::new(),
+                    open: OpenSet::new(s.volumes.polys.len()),
                 })
                 .collect(),
             events: Vec::new(),
@@ -109,9 +108,7 @@ struct LineState<'a> {
     aet: ActiveEdges<'a>,
     xs: Vec<(u32, u32)>,
     cursor: usize,
-    /// `open[t]`: where polygon t started covering (its slot in `open_list`), or NONE.
-    open: Vec<u32>,
-    open_list: Vec<(u32, u32)>,
+    open: OpenSet,
 }
 
 impl LineState<'_> {
@@ -121,34 +118,19 @@ impl LineState<'_> {
         // Bring the walk to the run's first pixel: the open polygons then cover it.
         while self.cursor < self.xs.len() && self.xs[self.cursor].0 <= run.x0 {
             let (_, t) = self.xs[self.cursor];
-            self.toggle(t, run.x0, |_, _, _| {});
+            self.open.toggle(t, run.x0);
             self.cursor += 1;
         }
-        for o in &mut self.open_list {
-            o.1 = run.x0;
-        }
+        self.open.restart_at(run.x0);
         pieces.clear();
         while self.cursor < self.xs.len() && self.xs[self.cursor].0 < run.x1 {
             let (at, t) = self.xs[self.cursor];
-            self.toggle(t, at, |t, s, e| pieces.push((t, s, e)));
+            if let Some(start) = self.open.toggle(t, at) {
+                pieces.push((t, start, at));
+            }
             self.cursor += 1;
         }
-        pieces.extend(self.open_list.iter().map(|&(t, s)| (t, s, run.x1)));
-    }
-
-    fn toggle(&mut self, tag: u32, at: u32, mut closed: impl FnMut(u32, u32, u32)) {
-        let slot = self.open[tag as usize];
-        if slot == NONE {
-            self.open[tag as usize] = self.open_list.len() as u32;
-            self.open_list.push((tag, at));
-        } else {
-            let (_, start) = self.open_list.swap_remove(slot as usize);
-            if let Some(&(moved, _)) = self.open_list.get(slot as usize) {
-                self.open[moved as usize] = slot;
-            }
-            self.open[tag as usize] = NONE;
-            closed(tag, start, at);
-        }
+        pieces.extend(self.open.open().map(|(t, s)| (t, s, run.x1)));
     }
 }
 
@@ -250,10 +232,7 @@ impl ShadowWalker for Walker<'_> {
             st.xs.clear();
             st.xs.extend(xs.iter().map(|c| (boundary(c.x, width), c.tag)));
             st.cursor = 0;
-            for &(t, _) in &st.open_list {
-                st.open[t as usize] = NONE;
-            }
-            st.open_list.clear();
+            st.open.clear();
         }
     }
 

@@ -8,7 +8,7 @@
 //! intervals where each of B's overlay polygons covers the run.
 
 use super::{Cover, Decision, Detail, ShadowContext, ShadowWalker};
-use crate::scan::{boundary, ActiveEdges, EdgeTable};
+use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::visibility::Run;
 use glam::DVec2;
 use rustc_hash::FxHashMap;
@@ -91,7 +91,7 @@ impl Overlay {
             end: lines.end,
             line: lines.start,
             active: (0..self.tables.len()).map(|_| None).collect(),
-            open: Vec::new(),
+            open: OpenSet::sparse(),
         }
     }
 }
@@ -103,7 +103,7 @@ pub struct OverlayWalker<'a> {
     end: u32,
     line: u32,
     active: Vec<Option<ActiveEdges<'a>>>,
-    open: Vec<(u32, f64)>,
+    open: OpenSet,
 }
 
 impl OverlayWalker<'_> {
@@ -122,15 +122,10 @@ impl OverlayWalker<'_> {
         let aet = self.active[slot as usize].get_or_insert_with(|| ActiveEdges::new(table, line..end));
         self.open.clear();
         for c in aet.advance_to(line) {
-            match self.open.iter().position(|o| o.0 == c.tag) {
-                None => self.open.push((c.tag, c.x)),
-                Some(k) => {
-                    let (_, xin) = self.open.swap_remove(k);
-                    let start = boundary(xin, u32::MAX).max(x0);
-                    let end = boundary(c.x, u32::MAX).min(x1);
-                    if start < end {
-                        out.push(Interval { start, end, tag: c.tag });
-                    }
+            if let Some(start) = self.open.toggle(c.tag, boundary(c.x, u32::MAX)) {
+                let (start, end) = (start.max(x0), boundary(c.x, u32::MAX).min(x1));
+                if start < end {
+                    out.push(Interval { start, end, tag: c.tag });
                 }
             }
         }

@@ -10,7 +10,7 @@
 //! cross and each part is solved again — Watkins' subdivision.
 
 use super::{push_run, Run, Visibility};
-use crate::scan::{boundary, ActiveEdges, EdgeTable};
+use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::scene::Scene;
 use crate::stats::Counters;
 use crate::view::{ScreenPolygon, View};
@@ -51,8 +51,7 @@ impl<'a> ScanlineVisibility<'a> {
 
     fn walk_lines(&self, lines: Range<u32>, counters: &mut Counters, record: bool, f: &mut LineSink) {
         let mut aet = ActiveEdges::new(&self.table, lines.clone());
-        let mut inside = vec![false; self.screen.len()];
-        let mut set: Vec<u32> = Vec::new();
+        let mut set = OpenSet::new(self.screen.len());
         let mut runs = Vec::new();
         let mut walk = Walk {
             screen: self.screen,
@@ -83,16 +82,10 @@ impl<'a> ScanlineVisibility<'a> {
             for c in xs {
                 let b = boundary(c.x, self.width);
                 if b > prev && !set.is_empty() {
-                    walk.resolve(&set, prev, b, 0, &mut runs);
+                    walk.resolve(set.tags(), prev, b, 0, &mut runs);
                 }
                 prev = prev.max(b);
-                let tag = c.tag as usize;
-                inside[tag] = !inside[tag];
-                if inside[tag] {
-                    set.push(c.tag);
-                } else if let Some(k) = set.iter().position(|&t| t == c.tag) {
-                    set.swap_remove(k);
-                }
+                set.toggle(c.tag, b);
             }
             // Every polygon's crossings pair up, so the set is empty again here.
             debug_assert!(set.is_empty());
@@ -106,8 +99,7 @@ impl<'a> ScanlineVisibility<'a> {
         counters.add("depth_tests", walk.depth_tests);
         counters.add("active_edges_max", max_active as u64);
         // Working memory of this band: active edges, the inside flags, the span set, the runs.
-        let band_bytes =
-            aet.bytes() + inside.capacity() + set.capacity() * 4 + runs.capacity() * std::mem::size_of::<Run>();
+        let band_bytes = aet.bytes() + set.bytes() + runs.capacity() * std::mem::size_of::<Run>();
         counters.add("band_bytes_max", band_bytes as u64);
     }
 }
