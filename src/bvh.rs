@@ -1,9 +1,9 @@
 //! A bounding-volume hierarchy over scene polygons for the ray-cast reference: median splits
 //! on the widest axis, exact ray-polygon tests (plane hit, then even-odd point in polygon).
 
-use crate::geometry::dominant_axis;
+use crate::geometry::{dominant_axis, even_odd_edges};
 use crate::scene::Scene;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 #[derive(Debug, Clone, Copy)]
 struct Node {
@@ -184,17 +184,8 @@ fn inside(verts: &[DVec3], axis: usize, p: DVec3) -> bool {
         1 => (2, 0),
         _ => (0, 1),
     };
-    let (pu, pv) = (p[u], p[v]);
-    let mut inside = false;
-    let mut a = verts[verts.len() - 1];
-    for &b in verts {
-        if (a[v] <= pv) != (b[v] <= pv) {
-            let x = a[u] + (pv - a[v]) / (b[v] - a[v]) * (b[u] - a[u]);
-            if x <= pu {
-                inside = !inside;
-            }
-        }
-        a = b;
-    }
-    inside
+    let flat = |q: DVec3| DVec2::new(q[u], q[v]);
+    let Some(&last) = verts.last() else { return false };
+    let ring = std::iter::once(last).chain(verts.iter().copied()).map(flat);
+    even_odd_edges(ring.clone().zip(ring.skip(1)), flat(p))
 }

@@ -128,3 +128,23 @@ pub(crate) fn parse_named<'a, T>(
         Error::InvalidOption(format!("unknown {what} '{s}' (known: {})", known.join(", ")))
     })
 }
+
+/// `FromStr` and `Display` by name for an enum of methods with `ALL` and `name()`: parsing
+/// finds the item named (and lists the known names when none is), showing writes the name.
+macro_rules! named {
+    ($t:ty, $what:literal) => {
+        impl std::str::FromStr for $t {
+            type Err = crate::error::Error;
+            fn from_str(s: &str) -> crate::error::Result<Self> {
+                crate::error::parse_named(s, &Self::ALL, |m| m.name(), $what).cloned()
+            }
+        }
+
+        impl std::fmt::Display for $t {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+    };
+}
+pub(crate) use named;

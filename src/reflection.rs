@@ -22,7 +22,7 @@
 
 use crate::error::Result;
 use crate::frame::{Frame, BACKGROUND};
-use crate::geometry::{clip_polygon, Plane};
+use crate::geometry::{clip_in_place, Plane};
 use crate::scene::{Camera, LightKind, Polygon, Scene};
 use glam::{DMat3, DMat4, DVec3};
 
@@ -53,12 +53,7 @@ impl ReflectionMethod {
     }
 }
 
-impl std::str::FromStr for ReflectionMethod {
-    type Err = crate::error::Error;
-    fn from_str(s: &str) -> crate::error::Result<Self> {
-        crate::error::parse_named(s, &Self::ALL, |m| m.name(), "reflection method").copied()
-    }
-}
+crate::error::named!(ReflectionMethod, "reflection method");
 
 /// The reflection through `plane` (`n·x + d = 0`), built as the "Special Effect" notes derive it:
 /// `M = T(p₀) · Rᵀ · S(1, −1, 1) · R · T(−p₀)` with `p₀ = −d n` the plane's point nearest the
@@ -131,10 +126,7 @@ fn mirrored_scene(scene: &Scene, plane: &Plane, m: DMat4, reflect_lights: bool) 
         }
         a.clear();
         a.extend(scene.verts(i).iter().zip(scene.vertex_normals(i)).map(|(&v, &n)| Vn(v, n)));
-        if a.iter().any(|x| plane.distance(x.0) < 0.0) {
-            clip_polygon(&a, |x: Vn| plane.distance(x.0), &mut b);
-            std::mem::swap(&mut a, &mut b);
-        }
+        clip_in_place(&mut a, &mut b, |x: Vn| plane.distance(x.0));
         if a.len() < 3 {
             continue;
         }

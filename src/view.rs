@@ -6,7 +6,7 @@
 //! affine function of screen position; each screen polygon carries it, derived straight from
 //! the world plane, so depth at a pixel centre is the exact ray-plane hit of section 3.
 
-use crate::geometry::{clip_polygon, Plane};
+use crate::geometry::{clip_in_place, Plane};
 use crate::scene::{Camera, Scene};
 use glam::{DVec2, DVec3, DVec4};
 
@@ -178,10 +178,7 @@ impl View {
             &|c: DVec4| g * c.z + c.y,
         ];
         for plane in planes {
-            if a.iter().any(|&c| plane(c) < 0.0) {
-                clip_polygon(a, plane, b);
-                std::mem::swap(a, b);
-            }
+            clip_in_place(a, b, plane);
         }
         if a.len() < 3 {
             return false;
@@ -210,15 +207,9 @@ impl View {
         let [a, b] = scratch;
         a.clear();
         a.extend(verts.iter().map(|&p| self.to_camera(p)));
-        if a.iter().any(|c| c.z < self.near) {
-            clip_polygon(a, |c| c.z - self.near, b);
-            std::mem::swap(a, b);
-        }
+        clip_in_place(a, b, |c| c.z - self.near);
         if let Some(far) = far {
-            if a.iter().any(|c| c.z > far) {
-                clip_polygon(a, |c| far - c.z, b);
-                std::mem::swap(a, b);
-            }
+            clip_in_place(a, b, |c| far - c.z);
         }
         // The guard band (10⁴ times the view's width): a polygon reaching beyond it is cut
         // there, far off screen, so that screen coordinates stay small enough for the scan
@@ -227,10 +218,7 @@ impl View {
         let band: [&dyn Fn(DVec3) -> f64; 4] =
             [&|c| g * c.z - c.x, &|c| g * c.z + c.x, &|c| g * c.z - c.y, &|c| g * c.z + c.y];
         for plane in band {
-            if a.iter().any(|&c| plane(c) < 0.0) {
-                clip_polygon(a, plane, b);
-                std::mem::swap(a, b);
-            }
+            clip_in_place(a, b, plane);
         }
         if a.len() < 3 {
             return false;

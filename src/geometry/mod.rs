@@ -130,6 +130,18 @@ pub fn classify_face(verts: &[DVec3]) -> FaceShape {
     FaceShape::Fan(fan)
 }
 
+/// Keeps the part of polygon `a` where `dist >= 0`, in place (`b` is scratch): the
+/// Sutherland-Hodgman step every clip by a half-space takes, skipped when no vertex is
+/// outside.
+pub(crate) fn clip_in_place<T>(a: &mut Vec<T>, b: &mut Vec<T>, dist: impl Fn(T) -> f64)
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Mul<f64, Output = T>,
+{
+    if a.iter().any(|&x| dist(x) < 0.0) {
+        clip_polygon(a, dist, b);
+        std::mem::swap(a, b);
+    }
+}
 /// Clips a polygon (convex or not) to the half-space `dist(p) >= 0` (Sutherland-Hodgman),
 /// in 3D or, with `DVec4`, in homogeneous coordinates. A concave polygon may come back with
 /// coincident "bridge" edges along the plane; the even-odd rule cancels them. Fewer than
@@ -170,12 +182,19 @@ where
 /// converter's half-open convention: an edge is crossed for `y_top <= p.y < y_bottom`, and a
 /// point is inside a span `[x_left, x_right)` that the crossings bound.
 pub fn inside_even_odd(ring: &[DVec2], p: DVec2) -> bool {
-    let mut inside = false;
     let Some(&last) = ring.last() else {
         return false;
     };
-    let mut a = last;
-    for &b in ring {
+    let edges = std::iter::once(last).chain(ring.iter().copied()).zip(ring.iter().copied());
+    even_odd_edges(edges, p)
+}
+
+/// The even-odd test over a region's edges `(a, b)`, in any order (the test of
+/// [`inside_even_odd`], for rings given other ways: projected from 3D, or as a clipper's
+/// pieces).
+pub(crate) fn even_odd_edges(edges: impl IntoIterator<Item = (DVec2, DVec2)>, p: DVec2) -> bool {
+    let mut inside = false;
+    for (a, b) in edges {
         let (top, bot) = if a.y <= b.y { (a, b) } else { (b, a) };
         if top.y <= p.y && p.y < bot.y {
             let x = top.x + (p.y - top.y) * ((bot.x - top.x) / (bot.y - top.y));
@@ -183,9 +202,22 @@ pub fn inside_even_odd(ring: &[DVec2], p: DVec2) -> bool {
                 inside = !inside;
             }
         }
-        a = b;
     }
     inside
+}
+
+/// The cells of a `g` x `g` grid over the box at `lo` of `size` that the box `(a, b)` meets,
+/// as (column, row), clamped to the grid.
+pub(crate) fn grid_cells(
+    lo: DVec2,
+    size: DVec2,
+    g: usize,
+    (a, b): (DVec2, DVec2),
+) -> impl Iterator<Item = (usize, usize)> {
+    let cell = move |v: f64, lo: f64, size: f64| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
+    let (c0, c1) = (cell(a.x, lo.x, size.x), cell(b.x, lo.x, size.x));
+    let (r0, r1) = (cell(a.y, lo.y, size.y), cell(b.y, lo.y, size.y));
+    (c0..=c1).flat_map(move |c| (r0..=r1).map(move |r| (c, r)))
 }
 
 /// The 2D projection of a 3D point that drops the normal's dominant axis, for point-in-polygon

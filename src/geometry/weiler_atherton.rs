@@ -32,7 +32,7 @@
 //! other at vertices or run back along themselves (bridges), but an edge should not cross
 //! another edge of its own region.
 
-use super::inside_even_odd;
+use super::{even_odd_edges, inside_even_odd};
 use glam::DVec2;
 use rustc_hash::FxHashMap as HashMap;
 
@@ -350,15 +350,7 @@ fn classify(pts: &[DVec2], sp: &[Piece], cp: &[Piece]) -> (Vec<Piece>, Vec<Piece
     let mid = |&(a, b): &(u32, u32)| (pts[a as usize] + pts[b as usize]) * 0.5;
     // Point-in-region by the even-odd rule over a region's pieces (bridges cancelled).
     let contains = |edges: &[(u32, u32)], p: DVec2| {
-        let mut inside = false;
-        for &(a, b) in edges {
-            let (a, b) = (pts[a as usize], pts[b as usize]);
-            let (top, bot) = if a.y <= b.y { (a, b) } else { (b, a) };
-            if top.y <= p.y && p.y < bot.y && top.x + (p.y - top.y) * ((bot.x - top.x) / (bot.y - top.y)) <= p.x {
-                inside = !inside;
-            }
-        }
-        inside
+        even_odd_edges(edges.iter().map(|&(a, b)| (pts[a as usize], pts[b as usize])), p)
     };
     let c_dir: HashMap<(u32, u32), ()> = cp.iter().map(|&e| (e, ())).collect();
     let s_dir: HashMap<(u32, u32), ()> = sp.iter().map(|&e| (e, ())).collect();

@@ -28,7 +28,7 @@ use super::projection::edge_on;
 use super::{ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::weiler_atherton::{clip, ClipError, Region};
-use crate::geometry::{clip_polygon, even_odd, Plane};
+use crate::geometry::{clip_in_place, clip_polygon, even_odd, grid_cells, Plane};
 use crate::scene::{LightSample, ObjText, Scene};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -148,12 +148,7 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
     };
     let g = ((list.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
     let size = (hi - lo).max(DVec2::splat(1e-300));
-    let cells_of = |b: (DVec2, DVec2)| {
-        let cell = |v: f64, lo: f64, size: f64| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
-        let (c0, c1) = (cell(b.0.x, lo.x, size.x), cell(b.1.x, lo.x, size.x));
-        let (r0, r1) = (cell(b.0.y, lo.y, size.y), cell(b.1.y, lo.y, size.y));
-        (c0..=c1).flat_map(move |c| (r0..=r1).map(move |r| c * g + r))
-    };
+    let cells_of = |b: (DVec2, DVec2)| grid_cells(lo, size, g, b).map(move |(c, r)| c * g + r);
     let mut grid: Vec<Vec<u32>> = vec![Vec::new(); g * g];
     let mut arena: Vec<Option<Piece>> = Vec::new();
     let mut heap = std::collections::BinaryHeap::new();
@@ -308,10 +303,7 @@ impl LightView {
                     &|p| p.dot(axis) - near,
                 ];
                 for f in planes {
-                    if a.iter().any(|&p| f(p) < 0.0) {
-                        clip_polygon(&a, f, &mut b);
-                        std::mem::swap(&mut a, &mut b);
-                    }
+                    clip_in_place(&mut a, &mut b, f);
                 }
                 if a.len() < 3 {
                     return None;

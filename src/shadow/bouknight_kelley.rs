@@ -37,6 +37,7 @@ use super::projection::{bounding_rectangle, edge_on, light_side, Projector};
 use super::{
     BouknightKelleyOptions, Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker,
 };
+use crate::geometry::grid_cells;
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -280,15 +281,10 @@ impl SphereGrid {
     /// The grid cells (column, row) that polygon `i`'s extent touches.
     fn cells_of(&self, i: u32) -> impl Iterator<Item = (usize, usize)> + '_ {
         let d = self.domain;
-        let (w, h) = ((d[2] - d[0]).max(1e-300), (d[3] - d[1]).max(1e-300));
+        let (lo, size) = (DVec2::new(d[0], d[1]), DVec2::new(d[2] - d[0], d[3] - d[1]).max(DVec2::splat(1e-300)));
         let g = self.g;
-        let cell =
-            move |v: f64, lo: f64, size: f64| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
-        self.extents[i as usize].boxes.into_iter().flatten().flat_map(move |b| {
-            let (c0, c1) = (cell(b[0], d[0], w), cell(b[2], d[0], w));
-            let (r0, r1) = (cell(b[1], d[1], h), cell(b[3], d[1], h));
-            (c0..=c1).flat_map(move |c| (r0..=r1).map(move |r| (c, r)))
-        })
+        let boxes = self.extents[i as usize].boxes.into_iter().flatten();
+        boxes.flat_map(move |b| grid_cells(lo, size, g, (DVec2::new(b[0], b[1]), DVec2::new(b[2], b[3]))))
     }
 
     /// The casters whose extents overlap receiver `b`'s: those sharing a grid cell with it

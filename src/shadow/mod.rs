@@ -394,18 +394,7 @@ impl ShadowMethod {
     }
 }
 
-impl std::str::FromStr for ShadowMethod {
-    type Err = crate::error::Error;
-    fn from_str(s: &str) -> crate::error::Result<Self> {
-        crate::error::parse_named(s, &Self::ALL, |m| m.name(), "shadow method").cloned()
-    }
-}
-
-impl std::fmt::Display for ShadowMethod {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+crate::error::named!(ShadowMethod, "shadow method");
 
 /// The `none` stage.
 struct NoShadows;

@@ -78,12 +78,7 @@ impl Counting {
     }
 }
 
-impl std::str::FromStr for Counting {
-    type Err = crate::error::Error;
-    fn from_str(s: &str) -> crate::error::Result<Self> {
-        crate::error::parse_named(s, &Self::ALL, |m| m.name(), "count").copied()
-    }
-}
+crate::error::named!(Counting, "count");
 
 /// What part of a volume's boundary a shadow polygon is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -82,18 +82,7 @@ impl VisibilityMethod {
     }
 }
 
-impl std::str::FromStr for VisibilityMethod {
-    type Err = crate::error::Error;
-    fn from_str(s: &str) -> crate::error::Result<Self> {
-        crate::error::parse_named(s, &Self::ALL, |m| m.name(), "visibility method").copied()
-    }
-}
-
-impl std::fmt::Display for VisibilityMethod {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+crate::error::named!(VisibilityMethod, "visibility method");
 
 /// The visible runs of every line of a frame: what every visibility stage hands on.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
