@@ -259,133 +259,150 @@ impl Scene {
             }
         })?;
 
-        let cam_span = raw.camera.span();
-        let c = raw.camera.into_inner();
-        let num = |x: &Option<Spanned<Num>>| x.as_ref().map(|x| x.get_ref().0);
-        let camera = Camera {
-            eye: v3(*c.eye.get_ref()),
-            target: v3(c.target),
-            up: c.up.as_ref().map_or(DVec3::Y, |u| v3(*u.get_ref())),
-            fov_y: num(&c.fov_y).unwrap_or(45.0),
-            width: c.width.as_ref().map_or(640, |w| *w.get_ref()),
-            height: c.height.as_ref().map_or(480, |h| *h.get_ref()),
-            near: num(&c.near).unwrap_or(0.01),
-            far: num(&c.far),
-        };
-        // A camera error names the line of the key that is wrong.
-        let key_span = |m: &str| {
-            let span = |key: &str| match key {
-                "eye" => Some(c.eye.span()),
-                "up" => c.up.as_ref().map(Spanned::span),
-                "fov_y" => c.fov_y.as_ref().map(Spanned::span),
-                "size" => c.width.as_ref().or(c.height.as_ref()).map(Spanned::span),
-                "near" => c.near.as_ref().map(Spanned::span),
-                "far" => c.far.as_ref().map(Spanned::span),
-                _ => None,
-            };
-            let key = m.strip_prefix("camera ").and_then(|r| r.split_whitespace().next()).unwrap_or("");
-            span(key).unwrap_or(cam_span.clone())
-        };
-        camera.validate().map_err(|m| cx.err(key_span(&m), m))?;
-
+        let camera = camera(&cx, raw.camera)?;
         let render = raw.render.map_or_else(RenderSettings::default, |r| RenderSettings {
             ambient: r.ambient.map_or(Vec3::splat(0.1), c3),
             background: r.background.map_or(Vec3::ZERO, c3),
         });
-
-        let mut materials = Vec::new();
-        let mut by_name = HashMap::new();
-        for m in raw.material {
-            let span = m.span();
-            let m = m.into_inner();
-            let name = m.name.get_ref().clone();
-            if by_name.insert(name.clone(), materials.len()).is_some() {
-                return Err(cx.err(m.name.span(), format!("material '{name}' is defined twice")));
-            }
-            let d = Material::new(name);
-            // Each ranged key is checked where it is written.
-            let ranged = |v: &Option<Spanned<Num32>>, key: &str, ok: fn(f32) -> bool, rule: &str, default: f32| match v
-            {
-                None => Ok(default),
-                Some(x) if ok(x.get_ref().0) => Ok(x.get_ref().0),
-                Some(x) => Err(cx.err(x.span(), format!("material {key} must be {rule}, got {}", x.get_ref().0))),
-            };
-            let unit = |x: f32| (0.0..=1.0).contains(&x);
-            let mat = Material {
-                color: m.color.map_or(d.color, c3),
-                specular_color: m.specular_color.map_or(d.specular_color, c3),
-                ka: m.ka.map_or(d.ka, |x| x.0),
-                kd: m.kd.map_or(d.kd, |x| x.0),
-                ks: m.ks.map_or(d.ks, |x| x.0),
-                shininess: ranged(&m.shininess, "shininess", |x| x >= 0.0, ">= 0", d.shininess)?,
-                model: m.model.unwrap_or(d.model),
-                roughness: ranged(&m.roughness, "roughness", |x| x > 0.0, "> 0", d.roughness)?,
-                fresnel: ranged(&m.fresnel, "fresnel", unit, "in [0, 1]", d.fresnel)?,
-                mirror: ranged(&m.mirror, "mirror", unit, "in [0, 1]", d.mirror)?,
-                shading: m.shading.unwrap_or(d.shading),
-                ..d
-            };
-            let _ = span;
-            materials.push(mat);
-        }
-
+        let (materials, by_name) = materials(&cx, raw.material)?;
         let lights = raw.light.into_iter().map(|l| light(&cx, l)).collect::<Result<Vec<_>>>()?;
-
-        let mut objects = Vec::new();
         let mut meshes: HashMap<PathBuf, Arc<Mesh>> = HashMap::new();
-        for o in raw.object {
-            let span = o.span();
-            let o = o.into_inner();
-            let material = match &o.material {
-                None => 0,
-                Some(name) => *by_name
-                    .get(name.get_ref())
-                    .ok_or_else(|| cx.err(name.span(), format!("no material named '{}'", name.get_ref())))?,
-            };
-            let mesh = match (o.mesh, o.polygons) {
-                (Some(_), Some(_)) => return Err(cx.err(span, "object has both 'mesh' and 'polygons'")),
-                (None, None) => return Err(cx.err(span, "object needs 'mesh' or 'polygons'")),
-                (None, Some(polys)) => {
-                    let polys: Vec<Vec<DVec3>> = polys.into_iter().map(|p| p.into_iter().map(v3).collect()).collect();
-                    if polys.iter().any(Vec::is_empty) {
-                        return Err(cx.err(span, "a polygon in 'polygons' has no vertices"));
-                    }
-                    Arc::new(Mesh::from_polygons(&polys))
-                }
-                (Some(rel), None) => {
-                    let path = dir.join(rel.get_ref());
-                    match meshes.get(&path) {
-                        Some(m) => m.clone(),
-                        None => {
-                            let bytes = std::fs::read(&path).map_err(|e| {
-                                cx.err(rel.span(), format!("cannot read mesh '{}': {e}", path.display()))
-                            })?;
-                            let text = utf8(bytes, &path)?;
-                            let m = Arc::new(super::parse_obj(&text, &path)?);
-                            meshes.insert(path, m.clone());
-                            m
-                        }
-                    }
-                }
-            };
-            objects.push(Object {
-                name: o.name,
-                material,
-                mesh,
-                transform: Transform {
-                    scale: o.scale.map_or(DVec3::ONE, |s| s.0),
-                    rotate: o.rotate.map_or(DVec3::ZERO, v3),
-                    translate: o.translate.map_or(DVec3::ZERO, v3),
-                },
-                casts_shadows: o.casts_shadows.unwrap_or(true),
-                receiver: o.receiver.unwrap_or(false),
-            });
-        }
+        let objects =
+            raw.object.into_iter().map(|o| object(&cx, o, &by_name, dir, &mut meshes)).collect::<Result<Vec<_>>>()?;
         Scene::new(camera, render, materials, lights, objects).map_err(|e| match e {
             Error::InvalidOption(m) => Error::input(FileLoc::file(file), m),
             e => e,
         })
     }
+}
+
+/// The `[camera]` table, checked; an error names the line of the key that is wrong.
+fn camera(cx: &Ctx, raw: Spanned<RawCamera>) -> Result<Camera> {
+    let cam_span = raw.span();
+    let c = raw.into_inner();
+    let num = |x: &Option<Spanned<Num>>| x.as_ref().map(|x| x.get_ref().0);
+    let camera = Camera {
+        eye: v3(*c.eye.get_ref()),
+        target: v3(c.target),
+        up: c.up.as_ref().map_or(DVec3::Y, |u| v3(*u.get_ref())),
+        fov_y: num(&c.fov_y).unwrap_or(45.0),
+        width: c.width.as_ref().map_or(640, |w| *w.get_ref()),
+        height: c.height.as_ref().map_or(480, |h| *h.get_ref()),
+        near: num(&c.near).unwrap_or(0.01),
+        far: num(&c.far),
+    };
+    // A camera error names the line of the key that is wrong.
+    let key_span = |m: &str| {
+        let span = |key: &str| match key {
+            "eye" => Some(c.eye.span()),
+            "up" => c.up.as_ref().map(Spanned::span),
+            "fov_y" => c.fov_y.as_ref().map(Spanned::span),
+            "size" => c.width.as_ref().or(c.height.as_ref()).map(Spanned::span),
+            "near" => c.near.as_ref().map(Spanned::span),
+            "far" => c.far.as_ref().map(Spanned::span),
+            _ => None,
+        };
+        let key = m.strip_prefix("camera ").and_then(|r| r.split_whitespace().next()).unwrap_or("");
+        span(key).unwrap_or(cam_span.clone())
+    };
+    camera.validate().map_err(|m| cx.err(key_span(&m), m))?;
+    Ok(camera)
+}
+
+/// The `[[material]]` tables, each ranged key checked where it is written, and the index of
+/// each by name.
+fn materials(cx: &Ctx, raw: Vec<Spanned<RawMaterial>>) -> Result<(Vec<Material>, HashMap<String, usize>)> {
+    let mut materials = Vec::new();
+    let mut by_name = HashMap::new();
+    for m in raw {
+        let span = m.span();
+        let m = m.into_inner();
+        let name = m.name.get_ref().clone();
+        if by_name.insert(name.clone(), materials.len()).is_some() {
+            return Err(cx.err(m.name.span(), format!("material '{name}' is defined twice")));
+        }
+        let d = Material::new(name);
+        // Each ranged key is checked where it is written.
+        let ranged = |v: &Option<Spanned<Num32>>, key: &str, ok: fn(f32) -> bool, rule: &str, default: f32| match v {
+            None => Ok(default),
+            Some(x) if ok(x.get_ref().0) => Ok(x.get_ref().0),
+            Some(x) => Err(cx.err(x.span(), format!("material {key} must be {rule}, got {}", x.get_ref().0))),
+        };
+        let unit = |x: f32| (0.0..=1.0).contains(&x);
+        let mat = Material {
+            color: m.color.map_or(d.color, c3),
+            specular_color: m.specular_color.map_or(d.specular_color, c3),
+            ka: m.ka.map_or(d.ka, |x| x.0),
+            kd: m.kd.map_or(d.kd, |x| x.0),
+            ks: m.ks.map_or(d.ks, |x| x.0),
+            shininess: ranged(&m.shininess, "shininess", |x| x >= 0.0, ">= 0", d.shininess)?,
+            model: m.model.unwrap_or(d.model),
+            roughness: ranged(&m.roughness, "roughness", |x| x > 0.0, "> 0", d.roughness)?,
+            fresnel: ranged(&m.fresnel, "fresnel", unit, "in [0, 1]", d.fresnel)?,
+            mirror: ranged(&m.mirror, "mirror", unit, "in [0, 1]", d.mirror)?,
+            shading: m.shading.unwrap_or(d.shading),
+            ..d
+        };
+        let _ = span;
+        materials.push(mat);
+    }
+    Ok((materials, by_name))
+}
+
+/// One `[[object]]` table: its material by name, its mesh (an OBJ file, read once however
+/// many objects name it, or inline polygons) and its transform.
+fn object(
+    cx: &Ctx,
+    o: Spanned<RawObject>,
+    by_name: &HashMap<String, usize>,
+    dir: &Path,
+    meshes: &mut HashMap<PathBuf, Arc<Mesh>>,
+) -> Result<Object> {
+    let span = o.span();
+    let o = o.into_inner();
+    let material = match &o.material {
+        None => 0,
+        Some(name) => *by_name
+            .get(name.get_ref())
+            .ok_or_else(|| cx.err(name.span(), format!("no material named '{}'", name.get_ref())))?,
+    };
+    let mesh = match (o.mesh, o.polygons) {
+        (Some(_), Some(_)) => return Err(cx.err(span, "object has both 'mesh' and 'polygons'")),
+        (None, None) => return Err(cx.err(span, "object needs 'mesh' or 'polygons'")),
+        (None, Some(polys)) => {
+            let polys: Vec<Vec<DVec3>> = polys.into_iter().map(|p| p.into_iter().map(v3).collect()).collect();
+            if polys.iter().any(Vec::is_empty) {
+                return Err(cx.err(span, "a polygon in 'polygons' has no vertices"));
+            }
+            Arc::new(Mesh::from_polygons(&polys))
+        }
+        (Some(rel), None) => {
+            let path = dir.join(rel.get_ref());
+            match meshes.get(&path) {
+                Some(m) => m.clone(),
+                None => {
+                    let bytes = std::fs::read(&path)
+                        .map_err(|e| cx.err(rel.span(), format!("cannot read mesh '{}': {e}", path.display())))?;
+                    let text = utf8(bytes, &path)?;
+                    let m = Arc::new(super::parse_obj(&text, &path)?);
+                    meshes.insert(path, m.clone());
+                    m
+                }
+            }
+        }
+    };
+    Ok(Object {
+        name: o.name,
+        material,
+        mesh,
+        transform: Transform {
+            scale: o.scale.map_or(DVec3::ONE, |s| s.0),
+            rotate: o.rotate.map_or(DVec3::ZERO, v3),
+            translate: o.translate.map_or(DVec3::ZERO, v3),
+        },
+        casts_shadows: o.casts_shadows.unwrap_or(true),
+        receiver: o.receiver.unwrap_or(false),
+    })
 }
 
 /// The text of a file, or an error naming the line of its first byte that is not UTF-8.
