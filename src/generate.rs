@@ -231,30 +231,7 @@ pub fn random(seed: u64, opts: RandomOptions) -> Result<Scene> {
     ]];
     let eye = DVec3::new(rng.gen_range(-3.0..3.0), rng.gen_range(1.5..4.0), rng.gen_range(3.0..5.0));
     for k in 0..opts.polygons {
-        let near_eye = k == 0 && rng.gen_bool(0.5);
-        let center = if near_eye {
-            // Straddles the camera's near plane: the eye sits almost on it.
-            eye + DVec3::new(rng.gen_range(-0.3..0.3), rng.gen_range(-0.3..0.3), -0.2)
-        } else {
-            DVec3::new(rng.gen_range(-2.0..2.0), rng.gen_range(0.2..2.0), rng.gen_range(-2.0..2.0))
-        };
-        let n = DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0))
-            .normalize_or(DVec3::Y);
-        let a = n.any_orthonormal_vector();
-        let b = n.cross(a);
-        let star = rng.gen_bool(0.4);
-        let sides = if star { 2 * rng.gen_range(3..6) } else { rng.gen_range(3..7) };
-        let r = rng.gen_range(0.4..1.4);
-        let phase = rng.gen_range(0.0..PI);
-        polys.push(
-            (0..sides)
-                .map(|i| {
-                    let t = phase + 2.0 * PI * i as f64 / sides as f64;
-                    let rr = if star && i % 2 == 1 { r * 0.45 } else { r };
-                    center + rr * (t.cos() * a + t.sin() * b)
-                })
-                .collect(),
-        );
+        polys.push(random_polygon(&mut rng, k == 0, eye));
     }
     let planes: Vec<_> = polys
         .iter()
@@ -266,39 +243,7 @@ pub fn random(seed: u64, opts: RandomOptions) -> Result<Scene> {
     let clear = |p: DVec3| planes.iter().all(|pl| pl.distance(p).abs() > 1e-3);
     let mut lights = Vec::new();
     for _ in 0..rng.gen_range(1..=3) {
-        let kind = loop {
-            // High above, among the polygons (planes through the light cut them), or just
-            // above the floor (a light close to a receiving plane).
-            let y = match rng.gen_range(0..6) {
-                0 | 1 => rng.gen_range(0.3..2.0),
-                2 => rng.gen_range(0.02..0.1),
-                _ => rng.gen_range(2.5..5.0),
-            };
-            let pos = DVec3::new(rng.gen_range(-3.0..3.0), y, rng.gen_range(-3.0..3.0));
-            let kind = match rng.gen_range(0..4) {
-                0 => LightKind::Point { position: pos },
-                1 => LightKind::Directional {
-                    direction: DVec3::new(rng.gen_range(-0.5..0.5), -1.0, rng.gen_range(-0.5..0.5)).normalize(),
-                },
-                2 => LightKind::Spot { position: pos, direction: (-pos).normalize(), cutoff: 60.0, exponent: 1.0 },
-                _ => LightKind::Area {
-                    corner: pos,
-                    edge_u: DVec3::new(rng.gen_range(0.2..0.8), 0.0, 0.0),
-                    edge_v: DVec3::new(0.0, 0.05, rng.gen_range(0.2..0.8)),
-                    samples: [2, 2],
-                },
-            };
-            let ok = Light { kind: kind.clone(), color: Vec3::ONE, intensity: 1.0, attenuation: [1.0, 0.0, 0.0] }
-                .samples()
-                .iter()
-                .all(|s| match s {
-                    crate::scene::LightSample::Point(p) => clear(*p),
-                    crate::scene::LightSample::Directional(_) => true,
-                });
-            if ok {
-                break kind;
-            }
-        };
+        let kind = random_light(&mut rng, &clear);
         lights.push(Light { kind, color: Vec3::ONE, intensity: 0.8, attenuation: [1.0, 0.0, 0.0] });
     }
     let cam = Camera { near: 0.05, ..camera(eye, DVec3::new(0.0, 0.5, 0.0), opts.width, opts.height) };
@@ -309,6 +254,71 @@ pub fn random(seed: u64, opts: RandomOptions) -> Result<Scene> {
         lights,
         vec![object(0, Mesh::from_polygons(&polys))],
     )
+}
+
+/// One random polygon of [`random`]: convex, or a star (concave), in a random orientation;
+/// the first may straddle the camera's near plane.
+fn random_polygon(rng: &mut ChaCha8Rng, first: bool, eye: DVec3) -> Vec<DVec3> {
+    let near_eye = first && rng.gen_bool(0.5);
+    let center = if near_eye {
+        // Straddles the camera's near plane: the eye sits almost on it.
+        eye + DVec3::new(rng.gen_range(-0.3..0.3), rng.gen_range(-0.3..0.3), -0.2)
+    } else {
+        DVec3::new(rng.gen_range(-2.0..2.0), rng.gen_range(0.2..2.0), rng.gen_range(-2.0..2.0))
+    };
+    let n =
+        DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)).normalize_or(DVec3::Y);
+    let a = n.any_orthonormal_vector();
+    let b = n.cross(a);
+    let star = rng.gen_bool(0.4);
+    let sides = if star { 2 * rng.gen_range(3..6) } else { rng.gen_range(3..7) };
+    let r = rng.gen_range(0.4..1.4);
+    let phase = rng.gen_range(0.0..PI);
+    (0..sides)
+        .map(|i| {
+            let t = phase + 2.0 * PI * i as f64 / sides as f64;
+            let rr = if star && i % 2 == 1 { r * 0.45 } else { r };
+            center + rr * (t.cos() * a + t.sin() * b)
+        })
+        .collect()
+}
+
+/// One random light of [`random`], of a random kind, placed high above, among the
+/// polygons, or just above the floor, with every sample `clear` of every polygon's plane.
+fn random_light(rng: &mut ChaCha8Rng, clear: &dyn Fn(DVec3) -> bool) -> LightKind {
+    loop {
+        // High above, among the polygons (planes through the light cut them), or just
+        // above the floor (a light close to a receiving plane).
+        let y = match rng.gen_range(0..6) {
+            0 | 1 => rng.gen_range(0.3..2.0),
+            2 => rng.gen_range(0.02..0.1),
+            _ => rng.gen_range(2.5..5.0),
+        };
+        let pos = DVec3::new(rng.gen_range(-3.0..3.0), y, rng.gen_range(-3.0..3.0));
+        let kind = match rng.gen_range(0..4) {
+            0 => LightKind::Point { position: pos },
+            1 => LightKind::Directional {
+                direction: DVec3::new(rng.gen_range(-0.5..0.5), -1.0, rng.gen_range(-0.5..0.5)).normalize(),
+            },
+            2 => LightKind::Spot { position: pos, direction: (-pos).normalize(), cutoff: 60.0, exponent: 1.0 },
+            _ => LightKind::Area {
+                corner: pos,
+                edge_u: DVec3::new(rng.gen_range(0.2..0.8), 0.0, 0.0),
+                edge_v: DVec3::new(0.0, 0.05, rng.gen_range(0.2..0.8)),
+                samples: [2, 2],
+            },
+        };
+        let ok = Light { kind: kind.clone(), color: Vec3::ONE, intensity: 1.0, attenuation: [1.0, 0.0, 0.0] }
+            .samples()
+            .iter()
+            .all(|s| match s {
+                crate::scene::LightSample::Point(p) => clear(*p),
+                crate::scene::LightSample::Directional(_) => true,
+            });
+        if ok {
+            return kind;
+        }
+    }
 }
 
 /// `n` random triangles with edges about `size` long, scattered through a cube of side 4 —

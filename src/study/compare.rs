@@ -12,7 +12,7 @@ use crate::frame::Frame;
 use crate::render::{render, RenderOptions};
 use crate::scene::Scene;
 use crate::shadow::ShadowMethod;
-use crate::study::bench::{measure, Spread};
+use crate::study::bench::{measure, Measured, Spread};
 use crate::study::escape;
 use crate::visibility::VisibilityMethod;
 use serde::Serialize;
@@ -158,7 +158,6 @@ pub fn compare(
     for &v in &opts.visibility {
         for s in &opts.shadows {
             bar.phase(format!("{v} + {s}"));
-            let id = format!("{v}-{s}");
             let ropts = RenderOptions { visibility: v, shadows: s.clone(), ..RenderOptions::default() };
             let (status, measured) = match measure(scene, &ropts, opts.warmup, opts.runs) {
                 Ok(m) => ("ok".to_string(), Some(m)),
@@ -167,47 +166,9 @@ pub fn compare(
                 Err(e) => return Err(e),
             };
             bar.advance(opts.runs.max(1) as u64);
-            let Some(m) = measured else {
-                results.push(MethodResult {
-                    visibility: v.name().into(),
-                    shadows: s.name().into(),
-                    status,
-                    exact: s.is_exact(),
-                    time: Spread { median_ms: 0.0, min_ms: 0.0, max_ms: 0.0 },
-                    times_ms: Vec::new(),
-                    step_ms: BTreeMap::new(),
-                    interior_pixels: 0,
-                    wrong_pixels: 0,
-                    error_share: 0.0,
-                    image: String::new(),
-                    diff: String::new(),
-                    counters: BTreeMap::new(),
-                });
-                continue;
-            };
-            let run = &m.last;
-            let (interior, wrong, diff_img) = diff(&reference, &run.frame);
-            let counters = run
-                .stats
-                .visibility_counters
-                .iter()
-                .map(|(k, v)| (format!("visibility.{k}"), v))
-                .chain(run.stats.shadow_counters.iter().map(|(k, v)| (format!("shadow.{k}"), v)))
-                .collect();
-            results.push(MethodResult {
-                visibility: v.name().into(),
-                shadows: s.name().into(),
-                status,
-                exact: s.is_exact(),
-                time: m.frame,
-                times_ms: m.times_ms.clone(),
-                step_ms: m.phases.iter().map(|(k, v)| (k.clone(), v.median_ms)).collect(),
-                interior_pixels: interior,
-                wrong_pixels: wrong,
-                error_share: wrong as f64 / interior.max(1) as f64,
-                image: save(run.frame.color_image(None), &format!("{id}.png"))?,
-                diff: save(diff_img, &format!("{id}-diff.png"))?,
-                counters,
+            results.push(match measured {
+                None => MethodResult::not_run(v, s, status),
+                Some(m) => MethodResult::measured(v, s, status, &m, &reference, |img, file| save(img, file))?,
             });
         }
     }
@@ -225,6 +186,64 @@ pub fn compare(
     };
     write_files(&report, &opts.out)?;
     Ok(report)
+}
+
+impl MethodResult {
+    /// A method that was not measured (not applicable to the scene, or failed), with why.
+    fn not_run(v: VisibilityMethod, s: &ShadowMethod, status: String) -> MethodResult {
+        MethodResult {
+            visibility: v.name().into(),
+            shadows: s.name().into(),
+            status,
+            exact: s.is_exact(),
+            time: Spread { median_ms: 0.0, min_ms: 0.0, max_ms: 0.0 },
+            times_ms: Vec::new(),
+            step_ms: BTreeMap::new(),
+            interior_pixels: 0,
+            wrong_pixels: 0,
+            error_share: 0.0,
+            image: String::new(),
+            diff: String::new(),
+            counters: BTreeMap::new(),
+        }
+    }
+
+    /// A measured method: its times, its last frame against `reference` (the image and the
+    /// wrong pixels, written by `save`), and its counters.
+    fn measured(
+        v: VisibilityMethod,
+        s: &ShadowMethod,
+        status: String,
+        m: &Measured,
+        reference: &Frame,
+        save: impl Fn(image::RgbImage, &str) -> Result<String>,
+    ) -> Result<MethodResult> {
+        let id = format!("{v}-{s}");
+        let run = &m.last;
+        let (interior, wrong, diff_img) = diff(reference, &run.frame);
+        let counters = run
+            .stats
+            .visibility_counters
+            .iter()
+            .map(|(k, v)| (format!("visibility.{k}"), v))
+            .chain(run.stats.shadow_counters.iter().map(|(k, v)| (format!("shadow.{k}"), v)))
+            .collect();
+        Ok(MethodResult {
+            visibility: v.name().into(),
+            shadows: s.name().into(),
+            status,
+            exact: s.is_exact(),
+            time: m.frame,
+            times_ms: m.times_ms.clone(),
+            step_ms: m.phases.iter().map(|(k, v)| (k.clone(), v.median_ms)).collect(),
+            interior_pixels: interior,
+            wrong_pixels: wrong,
+            error_share: wrong as f64 / interior.max(1) as f64,
+            image: save(run.frame.color_image(None), &format!("{id}.png"))?,
+            diff: save(diff_img, &format!("{id}-diff.png"))?,
+            counters,
+        })
+    }
 }
 
 fn write(path: &Path, text: &str) -> Result<()> {
@@ -432,25 +451,8 @@ fn rest(r: &MethodResult) -> String {
     format!("{:.1}", (r.time.median_ms - named).max(0.0))
 }
 
-fn html(report: &Report, out: &Path) -> String {
-    let mut h = String::new();
-    let _ = write!(
-        h,
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>umbra compare: {scene}</title>\n<style>\n\
-         body {{ font-family: sans-serif; margin: 1.5em; }}\ntable {{ border-collapse: collapse; font-size: 0.9em; }}\n\
-         th, td {{ border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: right; }}\nth {{ cursor: pointer; background: #eee; }}\n\
-         td.name {{ text-align: left; }}\n.na {{ color: #888; }}\n.noisy {{ color: #b3261e; }}\n.bars td {{ border: none; padding: 0.1em 0.5em; }}\n\
-         td.bar {{ width: 360px; }}\ntd.bar div {{ background: #4682b4; height: 0.9em; }}\n.grid {{ display: flex; flex-wrap: wrap; gap: 1em; }}\n\
-         figure {{ margin: 0; }}\nfigure img {{ width: 320px; image-rendering: pixelated; }}\nfigcaption {{ font-size: 0.85em; }}\n</style>\n</head>\n<body>\n\
-         <h1>umbra compare: {scene}</h1>\n<p>{w}&times;{h} pixels, {n} polygons. Errors are counted at the reference's interior pixels \
-         (3&times;3 neighbourhood uniform in face id and lit values); the reference is ray-cast visibility with ray-cast shadows. \
-         In the diff images, red marks wrong interior pixels and yellow marks differing pixels on edges (not counted).</p>\n",
-        scene = escape(&report.scene),
-        w = report.width,
-        h = report.height,
-        n = report.polygons
-    );
-    h.push_str(&report.about.html());
+/// The table of times and errors, one row a method, sortable by any column.
+fn results_table(report: &Report, out: &Path, h: &mut String) {
     h.push_str(
         "<h2>Times and errors</h2>\n<p>Click a column to sort. Times are the median (least–greatest) of the \
          timed runs after the warm-up; red where the runs spread over a fifth of the median (a busy machine). \
@@ -504,14 +506,10 @@ fn html(report: &Report, out: &Path) -> String {
         );
     }
     h.push_str("</tbody>\n</table>\n");
-    if cfg!(feature = "plots") {
-        h.push_str(
-            "<h2>Time against error</h2>\n<p>Exact methods (blue) lie on the zero line; bars span the least to \
-             the greatest run.</p>\n<img src=\"time-error.svg\" alt=\"frame time against wrong pixels\"> \
-             <a href=\"time-error.png\">PNG</a>\n<h2>Where the time goes</h2>\n<img src=\"phases.svg\" alt=\"time per phase\"> \
-             <a href=\"phases.png\">PNG</a>\n",
-        );
-    }
+}
+
+/// The reference, and each method's image beside its diff.
+fn images_html(report: &Report, h: &mut String) {
     h.push_str("<h2>Images</h2>\n<div class=\"grid\">\n");
     let _ = writeln!(
         h,
@@ -527,6 +525,37 @@ fn html(report: &Report, out: &Path) -> String {
         );
     }
     h.push_str("</div>\n");
+}
+
+fn html(report: &Report, out: &Path) -> String {
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>umbra compare: {scene}</title>\n<style>\n\
+         body {{ font-family: sans-serif; margin: 1.5em; }}\ntable {{ border-collapse: collapse; font-size: 0.9em; }}\n\
+         th, td {{ border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: right; }}\nth {{ cursor: pointer; background: #eee; }}\n\
+         td.name {{ text-align: left; }}\n.na {{ color: #888; }}\n.noisy {{ color: #b3261e; }}\n.bars td {{ border: none; padding: 0.1em 0.5em; }}\n\
+         td.bar {{ width: 360px; }}\ntd.bar div {{ background: #4682b4; height: 0.9em; }}\n.grid {{ display: flex; flex-wrap: wrap; gap: 1em; }}\n\
+         figure {{ margin: 0; }}\nfigure img {{ width: 320px; image-rendering: pixelated; }}\nfigcaption {{ font-size: 0.85em; }}\n</style>\n</head>\n<body>\n\
+         <h1>umbra compare: {scene}</h1>\n<p>{w}&times;{h} pixels, {n} polygons. Errors are counted at the reference's interior pixels \
+         (3&times;3 neighbourhood uniform in face id and lit values); the reference is ray-cast visibility with ray-cast shadows. \
+         In the diff images, red marks wrong interior pixels and yellow marks differing pixels on edges (not counted).</p>\n",
+        scene = escape(&report.scene),
+        w = report.width,
+        h = report.height,
+        n = report.polygons
+    );
+    h.push_str(&report.about.html());
+    results_table(report, out, &mut h);
+    if cfg!(feature = "plots") {
+        h.push_str(
+            "<h2>Time against error</h2>\n<p>Exact methods (blue) lie on the zero line; bars span the least to \
+             the greatest run.</p>\n<img src=\"time-error.svg\" alt=\"frame time against wrong pixels\"> \
+             <a href=\"time-error.png\">PNG</a>\n<h2>Where the time goes</h2>\n<img src=\"phases.svg\" alt=\"time per phase\"> \
+             <a href=\"phases.png\">PNG</a>\n",
+        );
+    }
+    images_html(report, &mut h);
     counters_html(report, &mut h);
     h.push_str(
         "<script>\ndocument.querySelectorAll('#results th').forEach((th, i) => th.addEventListener('click', () => {\n\
