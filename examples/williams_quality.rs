@@ -65,6 +65,7 @@ fn main() {
                         ShadowFilter::Nearest => "nearest".to_string(),
                         ShadowFilter::Pcf(n) => format!("pcf {n}x{n}"),
                         ShadowFilter::SoftEdge(n) => format!("soft-edge {n}"),
+                        other => format!("{other:?}"),
                     };
                     println!(
                         "| {name} | {map_size} | {bias_name} | {filter} | {:.3}% ({wrong}) | {:.1} |",

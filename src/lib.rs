@@ -73,7 +73,7 @@ pub use glam;
 pub use progress::{Progress, ProgressFn};
 pub use reflection::ReflectionMethod;
 pub use render::{render, RenderOptions, Rendered, Renderer};
-pub use scene::Scene;
+pub use scene::{Camera, Light, Material, Mesh, Object, Scene, SceneBuilder};
 pub use shadow::ShadowMethod;
 pub use stats::{Counters, Stats};
 pub use visibility::VisibilityMethod;

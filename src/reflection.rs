@@ -28,6 +28,7 @@ use glam::{DMat3, DMat4, DVec3};
 
 /// How mirrors are rendered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum ReflectionMethod {
     /// Mirrors are ordinary surfaces.
     Off,

@@ -11,6 +11,18 @@ use std::path::Path;
 pub const BACKGROUND: u32 = u32::MAX;
 
 /// A rendered image and its analysis buffers, row-major from the top-left pixel.
+///
+/// ```
+/// use umbra::{generate, render, RenderOptions, BACKGROUND};
+///
+/// let out = render(&generate::cubes(2, false, 64, 48)?, &RenderOptions::default())?;
+/// let f = &out.frame;
+/// let k = (24 * f.width + 32) as usize; // the pixel at (32, 24)
+/// assert_ne!(f.id[k], BACKGROUND); // the face seen there (the floor or a cube)
+/// assert!((0.0..=1.0).contains(&f.light[0][k])); // how much of light 0 reaches it
+/// f.save_png("target/cubes.png".as_ref(), Some(2.2))?;
+/// # Ok::<(), umbra::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
     /// Width in pixels.

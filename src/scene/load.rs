@@ -235,7 +235,22 @@ impl Ctx<'_> {
 }
 
 impl Scene {
-    /// Loads a scene file; meshes are read relative to its folder.
+    /// Loads a scene file (`docs/scene-format.md`); meshes are read relative to its folder.
+    /// Any problem is one [`Error`] naming the file and line:
+    ///
+    /// ```
+    /// use umbra::{Error, Scene};
+    ///
+    /// let scene = Scene::load("scenes/cornell.toml")?;
+    /// assert!(scene.lights().len() >= 1);
+    ///
+    /// std::fs::write("target/broken.toml", "[camera]\neye = [0, 0, 1]\ntarget = [0, 0, 0]\nfov = 45\n")?;
+    /// match Scene::load("target/broken.toml") {
+    ///     Err(Error::Load { loc, message }) => assert_eq!((loc.line, message.contains("fov")), (Some(4), true)),
+    ///     other => panic!("{other:?}"),
+    /// }
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
         let path = path.as_ref();
         let bytes = std::fs::read(path).map_err(|e| Error::Io { path: path.to_owned(), source: e })?;

@@ -1,8 +1,10 @@
 //! Scenes: the camera, materials, lights and objects of `docs/scene-format.md`, and the world-space
 //! polygons they compile to. Every polygon keeps its global face id.
 
+mod build;
 mod load;
 mod obj;
+pub use build::SceneBuilder;
 pub(crate) use obj::ObjText;
 mod write;
 
@@ -209,6 +211,7 @@ impl Material {
 
 /// What kind of light, with its geometry.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum LightKind {
     /// A point light.
     Point {

@@ -313,6 +313,21 @@ pub struct CountAdd {
 
 /// The shadow methods, each with its own settings. Chosen by name on the command line
 /// (`"crow".parse()` gives Crow with its defaults).
+///
+/// ```
+/// use umbra::shadow::{Counting, VolumeOptions, WilliamsOptions};
+/// use umbra::{generate, render, RenderOptions, ShadowMethod};
+///
+/// let scene = generate::cubes(2, false, 64, 48)?;
+/// let z_fail = ShadowMethod::Crow(VolumeOptions { counting: Counting::ZFail, ..Default::default() });
+/// let small_map = ShadowMethod::Williams(WilliamsOptions { map_size: 512, ..Default::default() });
+/// for shadows in [z_fail, small_map, "bouknight-kelley".parse()?] {
+///     let exact = shadows.is_exact();
+///     let out = render(&scene, &RenderOptions { shadows, ..Default::default() })?;
+///     println!("{} exact: {exact}", out.stats.shadows);
+/// }
+/// # Ok::<(), umbra::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum ShadowMethod {

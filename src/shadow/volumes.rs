@@ -53,6 +53,7 @@ use glam::{DVec2, DVec3, DVec4};
 
 /// How a count is taken along the line of sight.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[non_exhaustive]
 pub enum Counting {
     /// From the eye to the visible point, starting from the eye's own count (near caps).
     #[default]

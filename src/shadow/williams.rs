@@ -39,6 +39,7 @@ use wide::f32x4;
 
 /// How the shadow-map comparison is filtered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ShadowFilter {
     /// One texel, one comparison.
     Nearest,

@@ -41,6 +41,7 @@ pub(crate) trait Visibility: Sync {
 
 /// The visibility methods, chosen by name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum VisibilityMethod {
     /// Watkins' scanline algorithm with edge and active-edge tables.
     Scanline,
