@@ -469,3 +469,81 @@ impl ShadowWalker for Walker<'_> {
         counters.add("recursion_depth_max", self.depth_max as u64);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Camera, Light, Material, Mesh, Object};
+    use rand::{Rng, SeedableRng};
+
+    /// Whether the segment from `p` to `s` crosses triangle `t` (Möller-Trumbore).
+    fn crosses(p: DVec3, s: DVec3, t: &[DVec3]) -> bool {
+        let (d, e1, e2) = (s - p, t[1] - t[0], t[2] - t[0]);
+        let h = d.cross(e2);
+        let det = e1.dot(h);
+        if det.abs() < 1e-12 {
+            return false;
+        }
+        let q = p - t[0];
+        let u = q.dot(h) / det;
+        let w = q.cross(e1);
+        let v = d.dot(w) / det;
+        let along = e2.dot(w) / det;
+        u > 0.0 && v > 0.0 && u + v < 1.0 && along > 1e-9 && along < 1.0 - 1e-9
+    }
+
+    /// The sphere prefilter drops only pairs that cannot shadow: for random triangles around
+    /// a point light, many of them straddling the azimuth's wrap (directions toward -x, where
+    /// φ jumps from π to -π) or near the poles, every caster that a ray from a point of a
+    /// receiver to the light meets is among the receiver's candidates.
+    #[test]
+    fn prefilter_keeps_every_pair_a_shadow_ray_finds_including_across_the_azimuth_wrap() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1970);
+        for round in 0..20 {
+            let light = DVec3::ZERO;
+            let mut tris = Vec::new();
+            for k in 0..40 {
+                // Half the triangles toward -x (the wrap), a few near the poles.
+                let pole = if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
+                let dir = match k % 4 {
+                    0 | 1 => DVec3::new(-1.0, rng.gen_range(-0.3..0.3), rng.gen_range(-0.2..0.2)),
+                    2 => DVec3::new(rng.gen_range(-0.2..0.2), pole, rng.gen_range(-0.2..0.2)),
+                    _ => DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)),
+                }
+                .normalize_or(DVec3::X);
+                let c = dir * rng.gen_range(1.0..4.0);
+                let r = rng.gen_range(0.2..0.9);
+                let mut v = || c + DVec3::new(rng.gen_range(-r..r), rng.gen_range(-r..r), rng.gen_range(-r..r));
+                tris.push(vec![v(), v(), v()]);
+            }
+            let camera = Camera { width: 8, height: 8, ..Camera::new(DVec3::new(0.0, 0.0, 9.0), DVec3::ZERO) };
+            let scene = Scene::builder(camera)
+                .material(Material::new("m"))
+                .light(Light::point(light))
+                .object(Object::new(Mesh::from_polygons(&tris)), "m")
+                .build()
+                .unwrap();
+            let n = scene.polygons.len();
+            let casters: Vec<u32> = (0..n as u32).collect();
+            let grid = SphereGrid::new(&scene, LightSample::Point(light), &casters);
+            let mut stamp = vec![u32::MAX; n];
+            let mut found = 0;
+            for b in 0..n as u32 {
+                let kept = grid.candidates(b, &mut stamp);
+                let t = scene.verts(b as usize);
+                for _ in 0..200 {
+                    let (u, v) = (rng.gen_range(0.0..1.0f64), rng.gen_range(0.0..1.0f64));
+                    let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+                    let p = t[0] + (t[1] - t[0]) * u + (t[2] - t[0]) * v;
+                    for a in (0..n as u32).filter(|&a| a != b) {
+                        if crosses(p, light, scene.verts(a as usize)) {
+                            found += 1;
+                            assert!(kept.contains(&a), "round {round}: caster {a} shadows {b} at {p} but was dropped");
+                        }
+                    }
+                }
+            }
+            assert!(found > 0, "round {round}: the test found no shadowing pair");
+        }
+    }
+}
