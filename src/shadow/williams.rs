@@ -970,4 +970,69 @@ mod tests {
         let sum: f32 = taps.iter().map(|t| t.1).sum();
         assert!((sum - 1.0665).abs() < 1e-3, "{sum}");
     }
+
+    /// Pass 2's vector code against the same arithmetic one point at a time: for random
+    /// runs through a perspective and an orthographic map, every lane of every batch holds
+    /// the texel coordinates, threshold, corner texel and outside flag that the scalar
+    /// formulas give, bit for bit.
+    #[test]
+    fn vector_lookup_equals_the_scalar_formulas() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1978);
+        let size = 64u32;
+        let maps = [
+            pinhole(DVec3::new(0.0, 5.0, 0.0), DVec3::NEG_Y, DVec3::Z, 60.0, size, 1e-3),
+            orthographic(
+                DVec3::X,
+                DVec3::NEG_Y,
+                &[DVec3::splat(-2.0), DVec3::splat(2.0)],
+                &[DVec3::splat(-2.0), DVec3::splat(2.0)],
+                size,
+            ),
+        ];
+        for proj in maps {
+            let perspective = matches!(proj, Projection::Perspective(_));
+            let map = DepthMap { proj, rows: [DVec4::ZERO; 3], size, nearness: Vec::new(), storage: Pool::default() };
+            for _ in 0..200 {
+                let mut v4 = |lo: f32, hi: f32| [0; 4].map(|_| rng.gen_range(lo..hi));
+                let (l0, dl) = (v4(-80.0, 80.0), v4(-3.0, 3.0));
+                let (b0, b1, bs) =
+                    (rng.gen_range(0.0..0.1f32), rng.gen_range(0.0..0.01f32), rng.gen_range(0.0..0.1f32));
+                let lk = Lookup { l0, dl, b0, b1, bs, receiver_plane: None };
+                let (r, from, len) = (rng.gen_range(0..3usize), rng.gen_range(0..500usize), rng.gen_range(1..=BATCH));
+                let mut batch = Located::default();
+                map.locate(&lk, from, len, r, &mut batch);
+                for i in 0..len {
+                    let t = (from + i) as f32;
+                    let [x, y, z, w] = [0, 1, 2, 3].map(|c| l0[c] + dl[c] * t);
+                    let (px, py, threshold) = if perspective {
+                        let denom = z * (1.0 - b1) - w * b0;
+                        if z > 0.0 && denom > 0.0 {
+                            let q = 1.0 / z;
+                            (x * q, y * q, w / denom + bs)
+                        } else {
+                            (f32::NEG_INFINITY, f32::NEG_INFINITY, f32::INFINITY)
+                        }
+                    } else {
+                        let q = 1.0 / w;
+                        (x * q, y * q, (b0 + bs) - z * q)
+                    };
+                    let (g, l) = (i / 4, i % 4);
+                    let got = (batch.x[g][l], batch.y[g][l], batch.threshold[g][l]);
+                    assert_eq!(
+                        [got.0.to_bits(), got.1.to_bits(), got.2.to_bits()],
+                        [px.to_bits(), py.to_bits(), threshold.to_bits()],
+                        "point {i}: {got:?} against {:?}",
+                        (px, py, threshold)
+                    );
+                    let (lo, hi) = (r as f32, (size as usize - r) as f32);
+                    let inside = px >= lo && py >= lo && px < hi && py < hi;
+                    assert_eq!(batch.outside >> i & 1 == 1, !inside, "point {i} at ({px}, {py})");
+                    if inside {
+                        assert_eq!((batch.col[g][l], batch.row[g][l]), ((px - lo) as i32, (py - lo) as i32));
+                    }
+                }
+            }
+        }
+    }
 }
