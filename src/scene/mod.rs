@@ -273,12 +273,19 @@ impl LightSample {
     /// Whether the light is on the side of `plane` that the eye is on (the same-side rule of
     /// section 3). Both distances must be non-zero; a light on the plane lights neither side.
     pub fn on_seen_side(&self, plane: &Plane, eye: DVec3) -> bool {
-        let e = plane.distance(eye);
-        let l = match *self {
+        let (e, l) = (plane.distance(eye), self.side_of(plane));
+        e != 0.0 && l != 0.0 && (e > 0.0) == (l > 0.0)
+    }
+
+    /// Where the light lies relative to `plane`: positive on the side its normal points to,
+    /// negative behind, zero in it (a point light's signed distance; for a directional light,
+    /// `−n·d`). The one faces-the-light test: the same-side rule, the projection's side and
+    /// Williams' front-face culling all read it.
+    pub fn side_of(&self, plane: &Plane) -> f64 {
+        match *self {
             LightSample::Point(s) => plane.distance(s),
             LightSample::Directional(d) => -plane.n.dot(d),
-        };
-        e != 0.0 && l != 0.0 && (e > 0.0) == (l > 0.0)
+        }
     }
 
     /// Unit vector from `p` toward the light, and the distance (infinite for directional).

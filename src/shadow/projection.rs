@@ -10,11 +10,7 @@ use glam::{DVec2, DVec3};
 
 /// +1 or −1: the sign of `plane.distance` on the light's side of the plane.
 pub fn light_side(plane: &Plane, sample: LightSample) -> f64 {
-    let d = match sample {
-        LightSample::Point(s) => plane.distance(s),
-        LightSample::Directional(dir) => -plane.n.dot(dir),
-    };
-    if d >= 0.0 {
+    if sample.side_of(plane) >= 0.0 {
         1.0
     } else {
         -1.0

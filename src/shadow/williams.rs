@@ -249,11 +249,7 @@ impl DepthMap {
         let scene = ctx.scene;
         let casters = (0..scene.polygons.len()).filter(|&i| {
             let plane = &scene.polygons[i].plane;
-            let facing = match sample {
-                LightSample::Point(s) => plane.distance(s) > 0.0,
-                LightSample::Directional(d) => plane.n.dot(d) < 0.0,
-            };
-            scene.casts_shadows(i) && !(o.cull_front && facing)
+            scene.casts_shadows(i) && !(o.cull_front && sample.side_of(plane) > 0.0)
         });
         let screen: Vec<ScreenPolygon> = match &proj {
             Projection::Perspective(view) => {
