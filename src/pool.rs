@@ -66,6 +66,26 @@ pub(crate) struct Pools {
     pub(crate) masks: Pool<bool>,
     /// Points (the seen points Williams' maps are fitted to: two a visible run).
     pub(crate) points: Pool<glam::DVec3>,
+    /// Whole frames (what each mirror shows).
+    pub(crate) frames: Frames,
+}
+
+/// Whole frames kept for reuse; clones share them.
+#[derive(Clone, Default)]
+pub(crate) struct Frames(Arc<Mutex<Vec<crate::frame::Frame>>>);
+
+impl Frames {
+    /// A kept frame, if any.
+    pub(crate) fn take(&self) -> Option<crate::frame::Frame> {
+        self.0.lock().ok()?.pop()
+    }
+
+    /// Keeps `frame` for a later pass.
+    pub(crate) fn give(&self, frame: crate::frame::Frame) {
+        if let Ok(mut kept) = self.0.lock() {
+            kept.push(frame);
+        }
+    }
 }
 
 impl Pools {

@@ -23,6 +23,7 @@
 use crate::error::Result;
 use crate::frame::{Frame, BACKGROUND};
 use crate::geometry::{clip_in_place, Plane};
+use crate::pool::Pool;
 use crate::scene::{Camera, LightKind, Polygon, Scene};
 use glam::{DMat3, DMat4, DVec3};
 
@@ -178,14 +179,15 @@ fn reflected_camera(camera: &Camera, m: DMat4) -> Camera {
 }
 
 /// Adds the reflections of every mirror seen from the front to `frame` (whose visible runs
-/// are `runs`), and fills `frame.mirror_id`. `mirror_pass` renders what a mirror shows: the
-/// frame pass over the mirrored scene. Returns whether a mirror was seen.
+/// are `runs`), and fills `frame.mirror_id` (in a buffer from `ids`). `mirror_pass`
+/// renders what a mirror shows: the frame pass over the mirrored scene; each such frame is
+/// handed to `done` once blended in. Returns whether a mirror was seen.
 pub(crate) fn add_reflections(
     scene: &Scene,
     method: ReflectionMethod,
     frame: &mut Frame,
     runs: &crate::visibility::FrameRuns,
-    mut mirror_pass: impl FnMut(&Scene) -> Result<Frame>,
+    (ids, mut mirror_pass, mut done): (&Pool<u32>, impl FnMut(&Scene) -> Result<Frame>, impl FnMut(Frame)),
 ) -> Result<bool> {
     if method == ReflectionMethod::Off {
         return Ok(false);
@@ -204,7 +206,7 @@ pub(crate) fn add_reflections(
         return Ok(false);
     }
     let w = frame.width as usize;
-    let mut mirror_id = vec![BACKGROUND; frame.id.len()];
+    let mut mirror_id = ids.filled(frame.id.len(), BACKGROUND);
     for m_poly in mirrors {
         let plane = scene.polygons[m_poly as usize].plane;
         let rho = scene.material(m_poly as usize).mirror;
@@ -228,6 +230,7 @@ pub(crate) fn add_reflections(
                 }
             }
         }
+        done(seen);
     }
     frame.mirror_id = Some(mirror_id);
     Ok(true)

@@ -201,12 +201,15 @@ fn render_with(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<F
         let mirror_pass = |mirrored: &Scene| {
             // The mirrored scene has other polygons and lights: a database built beforehand
             // for the scene does not apply.
-            let (mut seen, _) =
-                frame_pass(mirrored, &inner, &Kept { awg_database: None, progress: None, ..*kept }, None)?;
+            let inner_kept = Kept { awg_database: None, progress: None, ..*kept };
+            let (mut seen, _) = frame_pass(mirrored, &inner, &inner_kept, kept.pools.frames.take())?;
             saturate(&mut seen.frame.color);
             Ok(seen.frame)
         };
-        if crate::reflection::add_reflections(scene, opts.reflection, &mut out.frame, &runs, mirror_pass)? {
+        // Each mirror's frame, once blended in, is kept for the next.
+        let done = |seen: Frame| kept.pools.frames.give(seen);
+        let passes = (&kept.pools.u32, mirror_pass, done);
+        if crate::reflection::add_reflections(scene, opts.reflection, &mut out.frame, &runs, passes)? {
             out.stats.time_ms.insert("reflections", ms(t.elapsed()));
         }
     }
@@ -256,7 +259,13 @@ fn frame_pass(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<Fr
     let t = Instant::now();
     let (lights, background) = (scene.lights.len(), scene.render.background);
     let mut frame = match spare {
-        Some(old) => Frame::recycle(old, view.width, view.height, lights, background),
+        Some(mut old) => {
+            // The last frame's mirror ids go back to the pool, for this frame's mirrors.
+            if let Some(ids) = old.mirror_id.take() {
+                pools.u32.give(ids);
+            }
+            Frame::recycle(old, view.width, view.height, lights, background)
+        }
         None => Frame::new(view.width, view.height, lights, background),
     };
     frame.light_samples = ctx.samples.iter().map(|s| s.len() as u32).collect();

@@ -78,4 +78,21 @@ fn a_renderer_allocates_no_frame_sized_buffer_after_its_first_frame() {
         umbra::render(&scene, &opts).unwrap();
         assert!(LARGE_ALLOCATIONS.load(Ordering::Relaxed) > before);
     }
+    // Mirrors: each mirror's frame, and the ids seen in it, come from the renderer too.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mirror.toml");
+    let mut scene = umbra::Scene::load(path).unwrap();
+    let mut camera = scene.camera().clone();
+    (camera.width, camera.height) = (w, h);
+    scene.set_camera(camera).unwrap();
+    for reflection in [umbra::ReflectionMethod::ReflectScene, umbra::ReflectionMethod::ReflectEye] {
+        let opts = RenderOptions { reflection, ..RenderOptions::default() };
+        let mut renderer = Renderer::new();
+        assert!(renderer.render(&scene, &opts).unwrap().frame.mirror_id.is_some(), "a mirror is seen");
+        let after_first = LARGE_ALLOCATIONS.load(Ordering::Relaxed);
+        for _ in 1..10 {
+            renderer.render(&scene, &opts).unwrap();
+        }
+        let more = LARGE_ALLOCATIONS.load(Ordering::Relaxed) - after_first;
+        assert_eq!(more, 0, "mirrors ({reflection:?}): {more} frame-sized allocations after the first frame");
+    }
 }
