@@ -23,7 +23,7 @@ fn main() -> umbra::Result<()> {
         }
         let r = renderer.render(&scene, &opts)?;
         let mut img = r.frame.color_image(None);
-        Frame::draw_outlines(&mut img, &r.outlines, [255, 40, 200]);
+        Frame::draw_outlines(&mut img, renderer.outlines(), [255, 40, 200]);
         let path = out.join(format!("{name}.png"));
         img.save(&path).map_err(|e| umbra::Error::Image { path, source: e.into() })?;
     }

@@ -505,12 +505,14 @@ fn render_command(a: RenderArgs) -> umbra::Result<()> {
     let bar = Arc::new(TerminalBar::new("{msg:40} {bar:30} {pos}/{len} lines {elapsed}"));
     let shown = bar.clone();
     let mut renderer = Renderer::new().with_progress(move |p| shown.report(p));
-    let out = renderer.render(&scene, &opts);
+    let rendered = renderer.render(&scene, &opts).map(|_| ());
     bar.finish();
-    let out = out?;
+    rendered?;
+    let outlines = renderer.outlines().to_vec();
+    let out = renderer.into_rendered().ok_or_else(|| Error::Internal("the renderer kept no frame".into()))?;
     let mut img = out.frame.color_image(a.gamma);
     if a.debug.is_some() {
-        umbra::Frame::draw_outlines(&mut img, &out.outlines, [255, 40, 200]);
+        umbra::Frame::draw_outlines(&mut img, &outlines, [255, 40, 200]);
     }
     write_png(img, &a.output)?;
     let mut wrote = a.output.display().to_string();

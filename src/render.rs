@@ -32,7 +32,7 @@ pub struct RenderOptions {
     /// How mirrors are rendered.
     pub reflection: crate::reflection::ReflectionMethod,
     /// Keep the screen outlines of the shadow stage's polygons (shadow polygons, detail
-    /// polygons) for the first light sample in [`Rendered::outlines`], to draw them over the
+    /// polygons) for the first light sample in [`Renderer::outlines`], to draw them over the
     /// image.
     pub outlines: bool,
 }
@@ -56,9 +56,6 @@ pub struct Rendered {
     pub frame: Frame,
     /// Counters and times.
     pub stats: Stats,
-    /// The outlines of the shadow stage's polygons for the first light sample, when
-    /// [`RenderOptions::outlines`] asked for them (empty otherwise).
-    pub outlines: Vec<Vec<glam::DVec2>>,
 }
 
 fn ms(d: Duration) -> f64 {
@@ -119,6 +116,7 @@ pub struct Renderer {
     awg_database: Option<Arc<Vec<ShadowDatabase>>>,
     progress: Option<Arc<ProgressFn>>,
     last: Option<Rendered>,
+    outlines: Vec<Vec<glam::DVec2>>,
 }
 
 impl Renderer {
@@ -131,8 +129,16 @@ impl Renderer {
     /// result lives until the next call.
     pub fn render(&mut self, scene: &Scene, opts: &RenderOptions) -> Result<&Rendered> {
         let spare = self.last.take().map(|r| r.frame);
-        let out = render_with(scene, opts, &self.kept(), spare)?;
+        let (out, outlines) = render_with(scene, opts, &self.kept(), spare)?;
+        self.outlines = outlines;
         Ok(self.last.insert(out))
+    }
+
+    /// The screen outlines of the last frame's shadow-stage polygons (shadow polygons,
+    /// detail polygons, shadow-volume polygons) for the first light sample, when
+    /// [`RenderOptions::outlines`] asked for them; empty otherwise. What `--debug` draws.
+    pub fn outlines(&self) -> &[Vec<glam::DVec2>] {
+        &self.outlines
     }
 
     /// Renders Atherton-Weiler-Greenberg's shadows from `databases` (one per light, built
@@ -180,8 +186,12 @@ impl Renderer {
 
 /// Renders `scene` with the chosen stages (a fresh [`Renderer`]'s one frame).
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered> {
-    render_with(scene, opts, &Kept { pools: &Default::default(), awg_database: None, progress: None }, None)
+    let kept = Kept { pools: &Default::default(), awg_database: None, progress: None };
+    Ok(render_with(scene, opts, &kept, None)?.0)
 }
+
+/// The screen outlines of a shadow stage's polygons.
+type Outlines = Vec<Vec<glam::DVec2>>;
 
 /// What a renderer keeps between frames and hands to the passes.
 struct Kept<'r> {
@@ -192,8 +202,8 @@ struct Kept<'r> {
 
 /// The frame pass, then the reflection pass over it, taking frame-sized buffers from `pools`
 /// and `spare`.
-fn render_with(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<Frame>) -> Result<Rendered> {
-    let (mut out, runs) = frame_pass(scene, opts, kept, spare)?;
+fn render_with(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<Frame>) -> Result<(Rendered, Outlines)> {
+    let (mut out, runs, outlines) = frame_pass(scene, opts, kept, spare)?;
     if opts.reflection != ReflectionMethod::Off {
         let t = Instant::now();
         // What a mirror shows is a frame of its own, with one level of reflection.
@@ -202,7 +212,7 @@ fn render_with(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<F
             // The mirrored scene has other polygons and lights: a database built beforehand
             // for the scene does not apply.
             let inner_kept = Kept { awg_database: None, progress: None, ..*kept };
-            let (mut seen, _) = frame_pass(mirrored, &inner, &inner_kept, kept.pools.frames.take())?;
+            let (mut seen, ..) = frame_pass(mirrored, &inner, &inner_kept, kept.pools.frames.take())?;
             saturate(&mut seen.frame.color);
             Ok(seen.frame)
         };
@@ -214,12 +224,17 @@ fn render_with(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<F
         }
     }
     saturate(&mut out.frame.color);
-    Ok(out)
+    Ok((out, outlines))
 }
 
 /// One frame, without reflections: view, visibility, shadow preparation, then the shadow
 /// walk and shading in parallel bands of lines. Returns the frame and its visible runs.
-fn frame_pass(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<Frame>) -> Result<(Rendered, FrameRuns)> {
+fn frame_pass(
+    scene: &Scene,
+    opts: &RenderOptions,
+    kept: &Kept,
+    spare: Option<Frame>,
+) -> Result<(Rendered, FrameRuns, Outlines)> {
     let pools = kept.pools;
     let start = Instant::now();
     // The camera is a public field: a program may have changed it since the scene was built.
@@ -283,10 +298,10 @@ fn frame_pass(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<Fr
     stats.time_ms.insert("shadow_walk", pass * walk_share);
     stats.time_ms.insert("shading", pass * (1.0 - walk_share));
     stats.time_ms.insert("total", ms(start.elapsed()));
-    let outlines = shadows.outlines();
+    let outlines = if opts.outlines { shadows.outlines() } else { Vec::new() };
     drop(shadows);
     drop(ctx);
-    Ok((Rendered { frame, stats, outlines }, runs))
+    Ok((Rendered { frame, stats }, runs, outlines))
 }
 
 /// The visibility stage: every line's visible runs, and the per-pixel counters of the

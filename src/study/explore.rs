@@ -196,10 +196,11 @@ impl Explorer {
         }
         let scene = self.scene_for(r)?;
         let opts = |shadows| RenderOptions { shadows, outlines: true, ..RenderOptions::default() };
-        let got = render(&scene, &opts(r.shadows.clone()))?;
+        let mut renderer = crate::Renderer::new();
+        let got = renderer.render(&scene, &opts(r.shadows.clone()))?.clone();
         let reference = render(&scene, &opts(ShadowMethod::RayCast))?;
         let png = crate::frame::encode_png(got.frame.color_image(None).into())?;
-        let mut summary = summary(&scene, r, &got, &reference);
+        let mut summary = summary(&scene, r, &got, &reference, renderer.outlines());
         // Only the shadow map has pictures; other stages are not prepared a second time.
         let made = match r.shadows {
             ShadowMethod::Williams(_) => super::trace::pictures(&scene, &r.shadows)?,
@@ -249,7 +250,7 @@ impl Explorer {
 
 /// What the page shows of a render: size, times, counters, the stage's polygons on screen
 /// (first light sample), and the pixels where it differs from ray-cast, ties told apart.
-fn summary(scene: &Scene, r: &Request, got: &Rendered, reference: &Rendered) -> Value {
+fn summary(scene: &Scene, r: &Request, got: &Rendered, reference: &Rendered, outlines: &[Vec<glam::DVec2>]) -> Value {
     let oracle = Reference::new(scene);
     let (mut wrong, mut ties) = (Vec::new(), Vec::new());
     let (mut wrong_total, mut ties_total) = (0usize, 0usize);
@@ -270,7 +271,7 @@ fn summary(scene: &Scene, r: &Request, got: &Rendered, reference: &Rendered) -> 
         }
     }
     let outlines: Vec<Vec<[f64; 2]>> =
-        got.outlines.iter().take(MAX_OUTLINES).map(|ring| ring.iter().map(|p| p.to_array()).collect()).collect();
+        outlines.iter().take(MAX_OUTLINES).map(|ring| ring.iter().map(|p| p.to_array()).collect()).collect();
     json!({
         "shadows": r.shadows.name(),
         "exact": r.shadows.is_exact(),
@@ -278,7 +279,7 @@ fn summary(scene: &Scene, r: &Request, got: &Rendered, reference: &Rendered) -> 
         "height": r.height,
         "stats": got.stats,
         "outlines": outlines,
-        "outlines_total": got.outlines.len(),
+        "outlines_total": outlines.len(),
         "differs": { "wrong": wrong, "wrong_total": wrong_total, "ties": ties, "ties_total": ties_total },
         "lights": scene.lights().iter().map(|l| json!({ "kind": kind_name(&l.kind), "at": at(&l.kind) })).collect::<Vec<_>>(),
     })
