@@ -241,6 +241,9 @@ struct Extent {
 /// touches.
 struct SphereGrid {
     extents: Vec<Extent>,
+    /// Each extent's cone half-angle as (cosine, sine), so that cones are compared without
+    /// an arccosine per pair.
+    cone_cs: Vec<(f64, f64)>,
     domain: [f64; 4],
     g: usize,
     cells: Vec<Vec<u32>>,
@@ -261,8 +264,10 @@ impl SphereGrid {
                 }),
         };
         let g = ((casters.len() as f64).sqrt().ceil() as usize).clamp(4, 1024);
+        let cone_cs = extents.iter().map(|e| (e.cone.1.cos(), e.cone.1.sin())).collect();
         let mut grid = SphereGrid {
             extents,
+            cone_cs,
             domain,
             g,
             cells: vec![Vec::new(); g * g],
@@ -300,9 +305,14 @@ impl SphereGrid {
                     continue;
                 }
                 stamp[a as usize] = b;
+                // The cones overlap when the angle between their axes is at most the sum
+                // of their half-angles: `acos(ac·bc) <= ah + bh`, that is (the sum below π,
+                // where the cosine falls) `ac·bc >= cos(ah + bh)`, with a hair of slack so
+                // that rounding can only keep a pair, never drop one.
                 let overlap = !self.point || {
                     let (ac, ah) = self.extents[a as usize].cone;
-                    ah + bh >= PI || ac.dot(bc).clamp(-1.0, 1.0).acos() <= ah + bh
+                    let ((ca, sa), (cb, sb)) = (self.cone_cs[a as usize], self.cone_cs[b as usize]);
+                    ah + bh >= PI || ac.dot(bc) >= ca * cb - sa * sb - 1e-12
                 };
                 if overlap {
                     out.push(a);
