@@ -177,15 +177,23 @@ pub fn hit(scene: &Scene, i: usize, o: DVec3, d: DVec3) -> Option<f64> {
     inside(scene.verts(i), dominant_axis(plane.n), p).then_some(t)
 }
 
-/// Even-odd test of a point on a polygon's plane, in the plane's projection that drops `axis`.
+/// Even-odd test of a point on a polygon's plane, in the plane's projection that drops `axis`
+/// (each projection its own monomorphic loop: this is the ray caster's innermost test).
 fn inside(verts: &[DVec3], axis: usize, p: DVec3) -> bool {
-    let (u, v) = match axis {
-        0 => (1, 2),
-        1 => (2, 0),
-        _ => (0, 1),
-    };
-    let flat = |q: DVec3| DVec2::new(q[u], q[v]);
+    match axis {
+        0 => inside_flat(verts, p, |q| DVec2::new(q.y, q.z)),
+        1 => inside_flat(verts, p, |q| DVec2::new(q.z, q.x)),
+        _ => inside_flat(verts, p, |q| DVec2::new(q.x, q.y)),
+    }
+}
+
+#[inline]
+fn inside_flat(verts: &[DVec3], p: DVec3, flat: impl Fn(DVec3) -> DVec2) -> bool {
     let Some(&last) = verts.last() else { return false };
-    let ring = std::iter::once(last).chain(verts.iter().copied()).map(flat);
-    even_odd_edges(ring.clone().zip(ring.skip(1)), flat(p))
+    let mut a = flat(last);
+    let edges = verts.iter().map(|&v| {
+        let b = flat(v);
+        (std::mem::replace(&mut a, b), b)
+    });
+    even_odd_edges(edges, flat(p))
 }

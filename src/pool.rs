@@ -6,17 +6,46 @@
 
 use std::sync::{Arc, Mutex};
 
-/// Buffers of `T` kept for reuse; clones share them.
-#[derive(Clone)]
-pub(crate) struct Pool<T>(Arc<Mutex<Vec<Vec<T>>>>);
+/// Things kept for reuse (buffers, whole frames); clones share them.
+pub(crate) struct Kept<B>(Arc<Mutex<Vec<B>>>);
 
-impl<T> Default for Pool<T> {
+impl<B> Default for Kept<B> {
     fn default() -> Self {
-        Pool(Arc::new(Mutex::new(Vec::new())))
+        Kept(Arc::new(Mutex::new(Vec::new())))
     }
 }
 
-impl<T> Pool<T> {
+impl<B> Clone for Kept<B> {
+    fn clone(&self) -> Self {
+        Kept(self.0.clone())
+    }
+}
+
+impl<B> Kept<B> {
+    /// Keeps `item` for a later frame.
+    fn keep(&self, item: B) {
+        if let Ok(mut kept) = self.0.lock() {
+            kept.push(item);
+        }
+    }
+
+    /// The kept item with the most `room`, if any.
+    fn take_roomiest(&self, room: impl Fn(&B) -> usize) -> Option<B> {
+        let mut kept = self.0.lock().ok()?;
+        let best = (0..kept.len()).max_by_key(|&i| room(&kept[i]))?;
+        Some(kept.swap_remove(best))
+    }
+
+    /// The sum of `bytes` over what is kept.
+    fn sum(&self, bytes: impl Fn(&B) -> usize) -> usize {
+        self.0.lock().map_or(0, |kept| kept.iter().map(bytes).sum())
+    }
+}
+
+/// Buffers of `T` kept for reuse.
+pub(crate) type Pool<T> = Kept<Vec<T>>;
+
+impl<T> Kept<Vec<T>> {
     /// A buffer of `len` copies of `value`, in kept memory where there is some.
     pub(crate) fn filled(&self, len: usize, value: T) -> Vec<T>
     where
@@ -30,24 +59,43 @@ impl<T> Pool<T> {
 
     /// A kept buffer (any length, any contents), the one with the most room; empty if none.
     pub(crate) fn take(&self) -> Vec<T> {
-        let Ok(mut kept) = self.0.lock() else { return Vec::new() };
-        let best = (0..kept.len()).max_by_key(|&i| kept[i].capacity());
-        best.map(|i| kept.swap_remove(i)).unwrap_or_default()
+        self.take_roomiest(Vec::capacity).unwrap_or_default()
     }
 
     /// Keeps `buffer` for a later frame.
     pub(crate) fn give(&self, buffer: Vec<T>) {
-        if buffer.capacity() == 0 {
-            return;
-        }
-        if let Ok(mut kept) = self.0.lock() {
-            kept.push(buffer);
+        if buffer.capacity() > 0 {
+            self.keep(buffer);
         }
     }
 
     /// Bytes kept.
     pub(crate) fn bytes(&self) -> usize {
-        self.0.lock().map_or(0, |kept| kept.iter().map(|b| b.capacity() * std::mem::size_of::<T>()).sum())
+        self.sum(|b| b.capacity() * std::mem::size_of::<T>())
+    }
+}
+
+/// Whole frames kept for reuse (what each mirror shows).
+pub(crate) type Frames = Kept<crate::frame::Frame>;
+
+impl Kept<crate::frame::Frame> {
+    /// A kept frame, if any (the largest).
+    pub(crate) fn take(&self) -> Option<crate::frame::Frame> {
+        self.take_roomiest(|f| f.id.capacity())
+    }
+
+    /// Keeps `frame` for a later pass.
+    pub(crate) fn give(&self, frame: crate::frame::Frame) {
+        self.keep(frame);
+    }
+
+    /// Bytes kept: colour, ids and lit fractions.
+    pub(crate) fn bytes(&self) -> usize {
+        self.sum(|f| {
+            f.color.capacity() * std::mem::size_of::<glam::Vec3>()
+                + f.id.capacity() * 4
+                + f.light.iter().map(|l| l.capacity() * 4).sum::<usize>()
+        })
     }
 }
 
@@ -70,24 +118,6 @@ pub(crate) struct Pools {
     pub(crate) frames: Frames,
 }
 
-/// Whole frames kept for reuse; clones share them.
-#[derive(Clone, Default)]
-pub(crate) struct Frames(Arc<Mutex<Vec<crate::frame::Frame>>>);
-
-impl Frames {
-    /// A kept frame, if any.
-    pub(crate) fn take(&self) -> Option<crate::frame::Frame> {
-        self.0.lock().ok()?.pop()
-    }
-
-    /// Keeps `frame` for a later pass.
-    pub(crate) fn give(&self, frame: crate::frame::Frame) {
-        if let Ok(mut kept) = self.0.lock() {
-            kept.push(frame);
-        }
-    }
-}
-
 impl Pools {
     /// Bytes kept in all of them.
     pub(crate) fn bytes(&self) -> usize {
@@ -97,6 +127,7 @@ impl Pools {
             + self.i32.bytes()
             + self.masks.bytes()
             + self.points.bytes()
+            + self.frames.bytes()
     }
 }
 

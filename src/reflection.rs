@@ -17,7 +17,7 @@
 //! stage shades the reflection. The reflected colour is blended into the mirror's own pixels,
 //! `(1 − ρ) own + ρ reflected`, and the face ids seen in the mirror fill `mirror_id`.
 //!
-//! The reflection matrix is built as the seed derives it, `T · Rᵀ · S(1, −1, 1) · R · T⁻¹`:
+//! The reflection matrix is built as the "Special Effect" notes derive it, `T · Rᵀ · S(1, −1, 1) · R · T⁻¹`:
 //! move the plane to the origin, rotate its normal onto the y axis, mirror y, undo.
 
 use crate::error::Result;
@@ -60,7 +60,7 @@ crate::error::named!(ReflectionMethod, "reflection method");
 /// The reflection through `plane` (`n·x + d = 0`), built as the "Special Effect" notes derive it:
 /// `M = T(p₀) · Rᵀ · S(1, −1, 1) · R · T(−p₀)` with `p₀ = −d n` the plane's point nearest the
 /// origin and `R` the rotation whose rows are `U, N, V` (N onto the y axis, U and V across it).
-/// (The seed writes the plane as `⟨N, P⟩ + d = 0` and the translations as `T(±dN)`; the
+/// (The notes write the plane as `⟨N, P⟩ + d = 0` and the translations as `T(±dN)`; the
 /// sign of `d` is its convention.)
 pub fn reflection_matrix(plane: &Plane) -> DMat4 {
     let n = plane.n;

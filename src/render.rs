@@ -298,7 +298,8 @@ fn frame_pass(
     stats.time_ms.insert("shadow_walk", pass * walk_share);
     stats.time_ms.insert("shading", pass * (1.0 - walk_share));
     stats.time_ms.insert("total", ms(start.elapsed()));
-    let outlines = if opts.outlines { shadows.outlines() } else { Vec::new() };
+    // Empty unless asked for: the stages keep outlines only then (`ShadowContext::keep_outlines`).
+    let outlines = shadows.outlines();
     drop(shadows);
     drop(ctx);
     Ok((Rendered { frame, stats }, runs, outlines))

@@ -192,11 +192,14 @@ pub fn inside_even_odd(ring: &[DVec2], p: DVec2) -> bool {
 /// The even-odd test over a region's edges `(a, b)`, in any order (the test of
 /// [`inside_even_odd`], for rings given other ways: projected from 3D, or as a clipper's
 /// pieces).
+#[inline]
 pub(crate) fn even_odd_edges(edges: impl IntoIterator<Item = (DVec2, DVec2)>, p: DVec2) -> bool {
     let mut inside = false;
     for (a, b) in edges {
-        let (top, bot) = if a.y <= b.y { (a, b) } else { (b, a) };
-        if top.y <= p.y && p.y < bot.y {
+        // An edge is crossed when its ends lie on either side of the line `y = p.y`
+        // (half-open: `y_top <= p.y < y_bottom`); most are not, and cost one comparison.
+        if (a.y <= p.y) != (b.y <= p.y) {
+            let (top, bot) = if a.y <= b.y { (a, b) } else { (b, a) };
             let x = top.x + (p.y - top.y) * ((bot.x - top.x) / (bot.y - top.y));
             if x <= p.x {
                 inside = !inside;

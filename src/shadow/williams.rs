@@ -21,7 +21,7 @@
 //! default: at grazing angles it detaches shadows). Filters: `nearest` (one texel), `pcf`
 //! (compare each of N×N texels,
 //! then average the answers — never the depths), and `soft-edge` (Shastry's "Soft-Edged Shadows": the PCF term of
-//! every pixel written to a screen-sized buffer, blurred by the seed's separable 15-tap
+//! every pixel written to a screen-sized buffer, blurred by Shastry's separable 15-tap
 //! Gaussian, and used when shading).
 
 use super::{Decision, ShadowContext, ShadowStage, ShadowWalker, Texel};
@@ -815,7 +815,7 @@ impl<'a> Williams<'a> {
 
     /// Shastry's "Soft-Edged Shadows": the N×N PCF term of every visible pixel in a screen-sized buffer (1 where
     /// nothing is seen, or the sample is on the polygon's unseen side), blurred horizontally
-    /// then vertically with the seed's 15 taps.
+    /// then vertically with Shastry's 15 taps.
     fn soft_edge_buffer(&self, light: usize, s: usize) -> Vec<f32> {
         let view = self.ctx.view;
         let (w, h) = (view.width as usize, view.height as usize);
