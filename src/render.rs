@@ -212,18 +212,18 @@ fn render_with(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<F
             // The mirrored scene has other polygons and lights: a database built beforehand
             // for the scene does not apply.
             let inner_kept = Kept { awg_database: None, progress: None, ..*kept };
-            let (mut seen, ..) = frame_pass(mirrored, &inner, &inner_kept, kept.pools.frames.take())?;
-            saturate(&mut seen.frame.color);
+            let (seen, ..) = frame_pass(mirrored, &inner, &inner_kept, kept.pools.frames.take())?;
             Ok(seen.frame)
         };
         // Each mirror's frame, once blended in, is kept for the next.
         let done = |seen: Frame| kept.pools.frames.give(seen);
         let passes = (&kept.pools.u32, mirror_pass, done);
         if crate::reflection::add_reflections(scene, opts.reflection, &mut out.frame, &runs, passes)? {
+            // Blending in what the mirrors show can overflow what the frame pass kept finite.
+            out.frame.color.par_chunks_mut(1 << 16).for_each(saturate);
             out.stats.time_ms.insert("reflections", ms(t.elapsed()));
         }
     }
-    saturate(&mut out.frame.color);
     Ok((out, outlines))
 }
 
@@ -401,10 +401,17 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
         });
         let t2 = Instant::now();
         walking += t2 - t;
+        // The frame comes in with last frame's pixels: every one is written here, the
+        // runs' pixels by the runs and the rest as background.
+        let bg = ctx.scene.render.background;
+        let mut gap = row;
         for run in runs {
             let (a, b) = (row + run.x0 as usize, row + run.x1 as usize);
+            clear(gap..a, bg, color, id, &mut light);
             id[a..b].fill(ctx.scene.polygons[run.poly as usize].face);
-            color[a..b].fill(shader.ambient(run.poly as usize));
+            for l in &mut light {
+                l[a..b].fill(0.0);
+            }
             shader.begin_run(run, y, &mut rs);
             for (k, (l, s, _)) in ctx.all_samples().enumerate() {
                 let at = k * w as usize;
@@ -413,14 +420,32 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
                 for (f, &v) in light[l][a..b].iter_mut().zip(lit) {
                     *f += v * share;
                 }
-                shader.add_light(&mut rs, l, s, lit, &mut color[a..b]);
+                shader.add_light(&mut rs, l, s, lit);
             }
+            shader.finish_run(&rs, &mut color[a..b]);
+            gap = b;
         }
+        clear(gap..row + w as usize, bg, color, id, &mut light);
         shading += t2.elapsed();
     }
     walker.finish(&mut shadow);
     shadow.add("self_shadowed_runs", self_shadowed);
     (shadow, walking, shading)
+}
+
+/// Background pixels: no polygon, no light.
+fn clear(
+    pixels: std::ops::Range<usize>,
+    background: Vec3,
+    color: &mut [Vec3],
+    id: &mut [u32],
+    light: &mut [&mut [f32]],
+) {
+    color[pixels.clone()].fill(background);
+    id[pixels.clone()].fill(crate::frame::BACKGROUND);
+    for l in light {
+        l[pixels.clone()].fill(0.0);
+    }
 }
 
 /// The shadow stage's walk along line `y`: for every run and light sample, the lit fraction

@@ -71,18 +71,20 @@ impl Frame {
         }
     }
 
-    /// A frame of background pixels in the memory of `old` (a frame rendered before), so
-    /// that rendering again writes into pages the process already has.
+    /// A frame in the memory of `old` (a frame rendered before), so that rendering again
+    /// writes into pages the process already has. Its pixels are `old`'s where `old` had
+    /// them, background beyond: the frame pass writes every pixel, line by line in its
+    /// parallel bands, rather than clearing the frame on one thread first.
     pub(crate) fn recycle(old: Frame, width: u32, height: u32, lights: usize, background: Vec3) -> Frame {
         let n = width as usize * height as usize;
         let Frame { mut color, mut id, mut light, .. } = old;
-        color.clear();
+        color.truncate(n);
         color.resize(n, background);
-        id.clear();
+        id.truncate(n);
         id.resize(n, BACKGROUND);
         light.resize_with(lights, Vec::new);
         for l in &mut light {
-            l.clear();
+            l.truncate(n);
             l.resize(n, 0.0);
         }
         Frame { width, height, color, id, light, light_samples: vec![1; lights], counters: None, mirror_id: None }

@@ -1,0 +1,616 @@
+//! Shading: the local illumination model of the "Lighting and Shading" and "Árnyékolás" notes
+//! (docs/sources.md) and the three shading modes.
+//!
+//! Per R, G, B, summed over lights `l` and their samples `s`:
+//!
+//! ```text
+//! I = Ia ka Od + Σ_l Σ_s S_s f_att(d_s) spot(L_s) (I_l / n_l) [kd Od (N.L_s) + ks Os spec]
+//! ```
+//!
+//! - `spec` is Phong's `(R.V)^n`, Blinn's `(N.H)^n`, or Cook-Torrance's
+//!   `π D F G / (4 N.V)`: the microfacet BRDF `D F G / (4 (N.L)(N.V))` times `π (N.L)`, so
+//!   that, like `kd Od (N.L)` for a Lambertian BRDF `kd Od / π`, it is radiance per unit
+//!   irradiance. D is Beckmann's distribution with the material's roughness `m`
+//!   (`exp(-tan²α/m²) / (π m² cos⁴α)`, normalised), F Schlick's Fresnel with the material's
+//!   `fresnel` F0 (default 0.04), G the Torrance-Sparrow geometry term
+//!   `min(1, 2(N.H)(N.V)/(V.H), 2(N.H)(N.L)/(V.H))`. Specular is zero where `N.L <= 0`.
+//! - `f_att = min(1, 1/(a + b d + c d²))` for point, spot and area samples; 1 for directional.
+//! - `spot = cos^exponent` of the angle to the spot axis inside the cone, 0 outside (shading
+//!   only: the contract's lit fraction ignores the cone).
+//! - `S_s`, the lit value from the shadow stage, applies per pixel in every mode, so a shadow
+//!   edge crosses a Gouraud-shaded polygon sharply instead of being smeared by interpolation.
+//!
+//! Shading modes, per material:
+//! - **flat**: one colour per polygon and sample, lit at the polygon's centroid with its
+//!   plane normal (the "Lighting and Shading" notes).
+//! - **Gouraud**: colours lit at the vertices (vertex normals from OBJ `vn`, or averaged over
+//!   the faces sharing the vertex), interpolated along the polygon's edges to the scanline and
+//!   along the span between them.
+//! - **Phong**: vertex normals interpolated the same way and renormalised, lit per pixel.
+//!
+//! Interpolation is perspective-correct: the scanline's crossings with the polygon's edges
+//! are taken in the *scan plane* (the plane through the eye and the scanline) in world space,
+//! and each pixel's point is placed between its two crossings in world space, so values vary
+//! linearly over the surface, not over the screen. Polygons are two-sided: normals are turned
+//! toward the viewer.
+//!
+//! Two paths compute this. The formulas below, [`incident`] and [`reflect`], are the
+//! reference, in f64, point by point. The frame's runs go, wherever they can, through
+//! the `lanes` module: eight pixels at a time in f32, each pixel's point and interpolation parameter
+//! found from its place along the run (one division each), and powers through
+//! `fast_pow`, whose error bound is stated and tested there. A run stays on the f64 path
+//! when its line crosses the polygon's outline more than twice (a concave polygon), when
+//! its points are too far from the eye for single precision (`LANE_REACH`), or, for one
+//! light sample, when that sample is too close to the polygon's plane for its direction to
+//! be found in single precision (`LANE_RATIO`). A test holds the two paths to each other
+//! on every run of random scenes.
+
+use crate::geometry::centroid;
+use crate::scene::{Light, LightKind, LightSample, Material, Scene, ShadingMode, SpecularModel};
+use crate::view::View;
+use crate::visibility::Run;
+use glam::{DVec3, Vec3};
+use lanes::{LaneLight, LaneMaterial, RunGeometry, RunLanes, Toward};
+
+mod fast_pow;
+mod lanes;
+use std::f64::consts::PI;
+
+/// The light a sample sends toward a point: unit direction to the light, and the radiance
+/// factor `f_att spot I_l / n_l` times the light's colour.
+pub fn incident(light: &Light, sample: &LightSample, samples: usize, p: DVec3) -> (DVec3, Vec3) {
+    let (l, d) = sample.toward(p);
+    let base = light.color * (light.intensity / samples as f32);
+    let att = match light.kind {
+        LightKind::Directional { .. } => 1.0,
+        _ => {
+            let [a, b, c] = light.attenuation;
+            (1.0 / (a + b * d + c * d * d)).min(1.0)
+        }
+    };
+    let spot = match light.kind {
+        LightKind::Spot { direction, cutoff, exponent, .. } => {
+            let cos = (-l).dot(direction);
+            if cos >= cutoff.to_radians().cos() {
+                cos.max(0.0).powf(exponent)
+            } else {
+                0.0
+            }
+        }
+        _ => 1.0,
+    };
+    (l, base * (att * spot) as f32)
+}
+
+/// `kd Od (N.L) + ks Os spec` for unit vectors `n` (turned toward the viewer), `v` (to the
+/// eye) and `l` (to the light); zero where `N.L <= 0`.
+pub fn reflect(m: &Material, n: DVec3, v: DVec3, l: DVec3) -> Vec3 {
+    let nl = n.dot(l);
+    if nl <= 0.0 {
+        return Vec3::ZERO;
+    }
+    m.kd * m.color * nl as f32 + m.ks * m.specular_color * specular(m, n, v, l, nl) as f32
+}
+
+fn specular(m: &Material, n: DVec3, v: DVec3, l: DVec3, nl: f64) -> f64 {
+    if m.ks == 0.0 {
+        return 0.0;
+    }
+    let shininess = m.shininess as f64;
+    match m.model {
+        SpecularModel::Phong => {
+            let r = 2.0 * nl * n - l;
+            r.dot(v).max(0.0).powf(shininess)
+        }
+        SpecularModel::Blinn => {
+            let h = (l + v).normalize_or_zero();
+            n.dot(h).max(0.0).powf(shininess)
+        }
+        SpecularModel::CookTorrance => {
+            let nv = n.dot(v);
+            let h = (l + v).normalize_or_zero();
+            let (nh, vh) = (n.dot(h), v.dot(h));
+            if nv <= 0.0 || nh <= 0.0 || vh <= 0.0 {
+                return 0.0;
+            }
+            let m2 = (m.roughness as f64).powi(2);
+            let cos2 = nh * nh;
+            let tan2 = (1.0 - cos2) / cos2;
+            let d = (-tan2 / m2).exp() / (PI * m2 * cos2 * cos2);
+            let f0 = m.fresnel as f64;
+            let f = f0 + (1.0 - f0) * (1.0 - vh).powi(5);
+            let g = (2.0 * nh * nv / vh).min(2.0 * nh * nl / vh).min(1.0);
+            PI * d * f * g / (4.0 * nv)
+        }
+    }
+}
+
+/// Shades runs of a scene seen from a view.
+pub(crate) struct Shader<'a> {
+    scene: &'a Scene,
+    view: &'a View,
+    samples: &'a [Vec<LightSample>],
+    /// Each light sample as the lane kernels see it, with its position for point samples.
+    lane_lights: Vec<Vec<(LaneLight, Option<DVec3>)>>,
+    /// Each material as the lane kernels see it.
+    lane_materials: Vec<LaneMaterial>,
+}
+
+/// Per-run scratch: what one run needs whatever the light (reused from run to run).
+#[derive(Debug, Default)]
+pub(crate) struct RunShading {
+    poly: usize,
+    mode: ShadingMode,
+    /// +1 or -1: turns the polygon's normals toward the viewer.
+    flip: f64,
+    centroid: DVec3,
+    /// The run's first pixel, its length, and its line's centre.
+    x0: u32,
+    len: u32,
+    yc: f64,
+    /// The scan plane's crossings with the polygon's edges, sorted along `along`, the line
+    /// where the polygon meets the scan plane.
+    crossings: Vec<ScanCrossing>,
+    along: DVec3,
+    /// Whether the run is in `lanes` (see [`lanes`]), and the larger `|p - eye|` of its ends.
+    in_lanes: bool,
+    reach: f64,
+    lanes: RunLanes,
+    /// The f64 path, filled for the runs and lights the lanes do not take, and the light
+    /// it added (`f64_lit`: whether it added any to this run).
+    f64_ready: bool,
+    f64_light: Vec<Vec3>,
+    f64_lit: bool,
+    /// World point seen at each pixel (Gouraud and Phong modes).
+    points: Vec<DVec3>,
+    /// Each pixel's value as weights of up to four of the polygon's vertices.
+    weights: Vec<[(u32, f64); 4]>,
+    /// Interpolated unit normal at each pixel (Phong mode).
+    normals: Vec<DVec3>,
+    /// Scratch: one value per polygon vertex (Gouraud mode).
+    vertex_colors: Vec<Vec3>,
+}
+
+/// Where an edge `k -> k+1` of the polygon meets the scan plane, at parameter `t` on the edge
+/// and `u` along the line where the polygon meets the scan plane.
+#[derive(Debug, Clone, Copy)]
+struct ScanCrossing {
+    u: f64,
+    k: u32,
+    t: f64,
+}
+
+/// Lanes take runs whose points lie within this distance of the eye, so that squared
+/// lengths stay far inside single precision.
+const LANE_REACH: f64 = 1e15;
+
+/// ... and a point light sample only where it is at least 1/`LANE_RATIO` as far from the
+/// polygon's plane as it and the run's points are from the eye: the vector from a pixel to
+/// the light is then found to a relative error below about `LANE_RATIO · 2⁻²³`, 1.2·10⁻⁴.
+const LANE_RATIO: f64 = 1000.0;
+
+impl<'a> Shader<'a> {
+    /// A shader for `scene` from `view`, with each light's samples.
+    pub fn new(scene: &'a Scene, view: &'a View, samples: &'a [Vec<LightSample>]) -> Self {
+        let lane_lights = scene
+            .lights
+            .iter()
+            .zip(samples)
+            .map(|(light, samples)| samples.iter().map(|s| lane_light(light, s, samples.len(), view.eye)).collect())
+            .collect();
+        let lane_materials = scene.materials.iter().map(lane_material).collect();
+        Shader { scene, view, samples, lane_lights, lane_materials }
+    }
+
+    /// The ambient term `Ia ka Od` of polygon `poly`.
+    pub fn ambient(&self, poly: usize) -> Vec3 {
+        let m = self.scene.material(poly);
+        self.scene.render.ambient * m.ka * m.color
+    }
+
+    /// Prepares `rs` for `run` on line `line`: where the polygon's outline crosses the line
+    /// and, for Gouraud and Phong shading, each pixel's place between those crossings (in
+    /// lanes, or in f64 when the run is not one for lanes).
+    pub fn begin_run(&self, run: &Run, line: u32, rs: &mut RunShading) {
+        let poly = run.poly as usize;
+        let plane = &self.scene.polygons[poly].plane;
+        rs.poly = poly;
+        rs.mode = self.scene.material(poly).shading;
+        rs.flip = if plane.distance(self.view.eye) >= 0.0 { 1.0 } else { -1.0 };
+        (rs.x0, rs.len, rs.yc) = (run.x0, run.x1 - run.x0, line as f64 + 0.5);
+        (rs.in_lanes, rs.f64_ready, rs.f64_lit) = (false, false, false);
+        rs.lanes.start(rs.len as usize);
+        if rs.mode == ShadingMode::Flat {
+            rs.centroid = centroid(self.scene.verts(poly));
+            return;
+        }
+        self.scan_crossings(rs);
+        rs.in_lanes = rs.crossings.len() == 2 && self.fill_lanes(rs);
+        if !rs.in_lanes {
+            self.prepare_f64(rs);
+        }
+    }
+
+    /// Fills `rs.crossings` and `rs.along`.
+    fn scan_crossings(&self, rs: &mut RunShading) {
+        let verts = self.scene.verts(rs.poly);
+        let plane = &self.scene.polygons[rs.poly].plane;
+        let eye = self.view.eye;
+        // The scan plane holds the eye and every ray of this scanline.
+        let ns = self.view.ray(0.0, rs.yc).cross(self.view.r);
+        rs.along = plane.n.cross(ns);
+        rs.crossings.clear();
+        let n = verts.len();
+        for k in 0..n {
+            let (a, b) = (verts[k], verts[(k + 1) % n]);
+            let (da, db) = (ns.dot(a - eye), ns.dot(b - eye));
+            if (da >= 0.0) != (db >= 0.0) {
+                let t = da / (da - db);
+                let c = a + (b - a) * t;
+                rs.crossings.push(ScanCrossing { u: (c - eye).dot(rs.along), k: k as u32, t });
+            }
+        }
+        rs.crossings.sort_unstable_by(|a, b| a.u.total_cmp(&b.u));
+    }
+
+    /// Fills the lanes of a run whose line crosses the outline twice, if its points fit
+    /// single precision ([`LANE_REACH`]); returns whether it did.
+    fn fill_lanes(&self, rs: &mut RunShading) -> bool {
+        let plane = &self.scene.polygons[rs.poly].plane;
+        let ray = self.view.ray(rs.x0 as f64 + 0.5, rs.yc);
+        let step = self.view.ray_step();
+        let depth = -plane.distance(self.view.eye);
+        let den = [plane.n.dot(ray), plane.n.dot(step)];
+        let reach = |i: f64| ((ray + step * i) * (depth / (den[0] + i * den[1]))).length();
+        rs.reach = reach(0.0).max(reach((rs.len - 1) as f64));
+        if rs.reach.is_nan() || rs.reach >= LANE_REACH {
+            return false;
+        }
+        let (l, r) = (rs.crossings[0], rs.crossings[1]);
+        // s = (u - u_l) / (u_r - u_l), with u = depth (ray_i . along) / den_i.
+        let (s_num, s_div) = if r.u > l.u {
+            let du = r.u - l.u;
+            let num = [depth * ray.dot(rs.along) - l.u * den[0], depth * step.dot(rs.along) - l.u * den[1]];
+            (num, [du * den[0], du * den[1]])
+        } else {
+            ([0.5, 0.0], [1.0, 0.0])
+        };
+        let normals = (rs.mode == ShadingMode::Phong).then(|| {
+            let vn = self.scene.vertex_normals(rs.poly);
+            let at = |c: ScanCrossing| crossing_value(vn, c, |v| *v) * rs.flip;
+            [at(l), at(r), plane.n * rs.flip].map(|v| v.as_vec3().to_array())
+        });
+        let f32s = |v: [f64; 2]| v.map(|x| x as f32);
+        let g = RunGeometry {
+            ray: ray.as_vec3().to_array(),
+            step: step.as_vec3().to_array(),
+            depth: depth as f32,
+            den: f32s(den),
+            s_num: f32s(s_num),
+            s_div: f32s(s_div),
+            normals,
+        };
+        rs.lanes.fill(&g, rs.len as usize);
+        true
+    }
+
+    /// The f64 path's points, weights and (Phong mode) normals.
+    fn prepare_f64(&self, rs: &mut RunShading) {
+        let plane = &self.scene.polygons[rs.poly].plane;
+        rs.points.clear();
+        let (x0, yc) = (rs.x0, rs.yc);
+        rs.points.extend((x0..x0 + rs.len).map(|x| self.view.point_on(plane, x as f64 + 0.5, yc)));
+        self.interpolation_weights(rs);
+        if rs.mode == ShadingMode::Phong {
+            let vn = self.scene.vertex_normals(rs.poly);
+            rs.normals.clear();
+            rs.normals.extend(rs.weights.iter().map(|w| {
+                let n: DVec3 = w.iter().map(|&(k, a)| vn[k as usize] * a).sum();
+                (n * rs.flip).normalize_or(plane.n * rs.flip)
+            }));
+        }
+        rs.f64_ready = true;
+    }
+
+    /// Fills `rs.weights`: each pixel's point as a blend of the two edge crossings of the scan
+    /// plane that bracket it, each a blend of its edge's two vertices.
+    fn interpolation_weights(&self, rs: &mut RunShading) {
+        let n = self.scene.polygons[rs.poly].len;
+        let eye = self.view.eye;
+        rs.weights.clear();
+        let pairs = rs.crossings.len() / 2;
+        for p in &rs.points {
+            let w = if pairs == 0 {
+                // The scanline only grazes the polygon: fall back to its first vertex.
+                [(0, 1.0), (0, 0.0), (0, 0.0), (0, 0.0)]
+            } else {
+                let u = (*p - eye).dot(rs.along);
+                // The pair whose interval holds u (or, through rounding at an end, the nearest).
+                let j = (0..pairs)
+                    .min_by(|&i, &j| {
+                        let gap = |i: usize| {
+                            let (l, r) = (rs.crossings[2 * i].u, rs.crossings[2 * i + 1].u);
+                            (l - u).max(u - r).max(0.0)
+                        };
+                        gap(i).total_cmp(&gap(j))
+                    })
+                    .unwrap_or(0);
+                let (l, r) = (rs.crossings[2 * j], rs.crossings[2 * j + 1]);
+                let s = if r.u > l.u { ((u - l.u) / (r.u - l.u)).clamp(0.0, 1.0) } else { 0.5 };
+                let next = |k: u32| (k + 1) % n;
+                [
+                    (l.k, (1.0 - l.t) * (1.0 - s)),
+                    (next(l.k), l.t * (1.0 - s)),
+                    (r.k, (1.0 - r.t) * s),
+                    (next(r.k), r.t * s),
+                ]
+            };
+            rs.weights.push(w);
+        }
+    }
+
+    /// Adds the light of sample `sample` of light `light` to the run prepared in `rs`,
+    /// pixel `i` weighted by its lit value `lit[i]`.
+    pub fn add_light(&self, rs: &mut RunShading, light: usize, sample: usize, lit: &[f32]) {
+        let l = &self.scene.lights[light];
+        let s = &self.samples[light][sample];
+        let ns = self.samples[light].len();
+        let m = self.scene.material(rs.poly);
+        let eye = self.view.eye;
+        let shade = |p: DVec3, n: DVec3| {
+            let (to_light, radiance) = incident(l, s, ns, p);
+            radiance * reflect(m, n, (eye - p).normalize(), to_light)
+        };
+        match rs.mode {
+            ShadingMode::Flat => {
+                let n = self.scene.polygons[rs.poly].plane.n * rs.flip;
+                rs.lanes.add_flat(shade(rs.centroid, n), lit);
+            }
+            ShadingMode::Gouraud => {
+                let verts = self.scene.verts(rs.poly);
+                let vn = self.scene.vertex_normals(rs.poly);
+                rs.vertex_colors.clear();
+                rs.vertex_colors.extend(verts.iter().zip(vn).map(|(&p, &n)| shade(p, n * rs.flip)));
+                if rs.in_lanes {
+                    let at = |c: ScanCrossing| crossing_value(&rs.vertex_colors, c, |v| v.as_dvec3()).as_vec3();
+                    let (left, right) = (at(rs.crossings[0]), at(rs.crossings[1]));
+                    rs.lanes.add_gouraud(left, right, lit);
+                    return;
+                }
+                let (weights, colors) = (&rs.weights, &rs.vertex_colors);
+                add_f64(&mut rs.f64_light, &mut rs.f64_lit, lit, |i| {
+                    weights[i].iter().map(|&(k, a)| colors[k as usize] * a as f32).sum()
+                });
+            }
+            ShadingMode::Phong => {
+                if let Some(ll) = self.lane_light_for(rs, light, sample) {
+                    rs.lanes.add_phong(
+                        ll,
+                        &self.lane_materials[self.scene.objects[self.scene.polygons[rs.poly].object as usize].material],
+                        lit,
+                    );
+                    return;
+                }
+                if !rs.f64_ready {
+                    self.prepare_f64(rs);
+                }
+                let (points, normals) = (&rs.points, &rs.normals);
+                add_f64(&mut rs.f64_light, &mut rs.f64_lit, lit, |i| shade(points[i], normals[i]));
+            }
+        }
+    }
+
+    /// Writes the run's pixels to `out`: the ambient term and the light its samples added,
+    /// kept finite.
+    pub fn finish_run(&self, rs: &RunShading, out: &mut [Vec3]) {
+        rs.lanes.finish(self.ambient(rs.poly), out);
+        if rs.f64_lit {
+            for (o, l) in out.iter_mut().zip(&rs.f64_light) {
+                *o = finite(*o + *l);
+            }
+        }
+    }
+
+    /// The lanes' view of a light sample, if the run is in lanes and the sample is one the
+    /// lanes can take for it ([`LANE_RATIO`]).
+    fn lane_light_for(&self, rs: &RunShading, light: usize, sample: usize) -> Option<&LaneLight> {
+        let (ll, position) = self.lane_lights[light].get(sample)?;
+        let ok = rs.in_lanes
+            && match position {
+                None => true,
+                Some(p) => {
+                    let plane = &self.scene.polygons[rs.poly].plane;
+                    let far = (*p - self.view.eye).length() + rs.reach;
+                    far < LANE_REACH && far < LANE_RATIO * plane.distance(*p).abs()
+                }
+            };
+        ok.then_some(ll)
+    }
+}
+
+/// Adds `color(i) * lit[i]` to the f64 path's light, `light`, for every lit pixel `i`
+/// (zeroing `light` first if this run had none there yet).
+fn add_f64(light: &mut Vec<Vec3>, used: &mut bool, lit: &[f32], color: impl Fn(usize) -> Vec3) {
+    if !*used {
+        light.clear();
+        light.resize(lit.len(), Vec3::ZERO);
+        *used = true;
+    }
+    for (i, (o, &v)) in light.iter_mut().zip(lit).enumerate() {
+        if v != 0.0 {
+            *o += color(i) * v;
+        }
+    }
+}
+
+/// A channel that overflowed (to infinity, or to not-a-number through infinity times zero
+/// or less infinity) becomes the largest finite value, as an overflow should look.
+fn finite(c: Vec3) -> Vec3 {
+    let f = |x: f32| if x.is_nan() { f32::MAX } else { x.clamp(-f32::MAX, f32::MAX) };
+    Vec3::new(f(c.x), f(c.y), f(c.z))
+}
+
+/// The value at a scan crossing, between its edge's two vertices' values.
+fn crossing_value<T>(values: &[T], c: ScanCrossing, get: impl Fn(&T) -> DVec3) -> DVec3 {
+    let next = (c.k as usize + 1) % values.len();
+    get(&values[c.k as usize]) * (1.0 - c.t) + get(&values[next]) * c.t
+}
+
+/// A light sample as the lanes see it, and where it is when it is a point.
+fn lane_light(light: &Light, sample: &LightSample, samples: usize, eye: DVec3) -> (LaneLight, Option<DVec3>) {
+    let f32s = |v: DVec3| v.as_vec3().to_array();
+    let (toward, position) = match *sample {
+        LightSample::Point(p) => (Toward::Point(f32s(p - eye)), Some(p)),
+        LightSample::Directional(d) => (Toward::Direction(f32s(-d)), None),
+    };
+    let spot = match light.kind {
+        LightKind::Spot { direction, cutoff, exponent, .. } => {
+            Some((f32s(direction), cutoff.to_radians().cos() as f32, exponent as f32))
+        }
+        _ => None,
+    };
+    let radiance = (light.color * (light.intensity / samples as f32)).to_array();
+    (LaneLight { toward, radiance, attenuation: light.attenuation.map(|a| a as f32), spot }, position)
+}
+
+/// A material as the lanes see it.
+fn lane_material(m: &Material) -> LaneMaterial {
+    LaneMaterial {
+        diffuse: (m.kd * m.color).to_array(),
+        specular: (m.ks * m.specular_color).to_array(),
+        model: m.model,
+        shininess: m.shininess,
+        m2: m.roughness * m.roughness,
+        f0: m.fresnel,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every run of random scenes (convex and star-shaped polygons, point, spot, directional
+    /// and area lights), shaded by the lanes and by the f64 path.
+    #[test]
+    fn lanes_agree_with_the_f64_path_on_random_scenes() {
+        use crate::generate::{random, RandomOptions};
+        use crate::visibility::{resolve_frame, VisibilityMethod};
+        let (mut worst, mut in_lanes, mut in_f64) = (0.0f32, 0, 0);
+        for seed in 0..40u64 {
+            let mut scene = random(seed, RandomOptions { polygons: 8, width: 96, height: 72 }).unwrap();
+            let mut materials = scene.materials().to_vec();
+            for (i, m) in materials.iter_mut().enumerate() {
+                let k = seed as usize + i;
+                m.shading = [ShadingMode::Phong, ShadingMode::Gouraud][k % 2];
+                m.model = [SpecularModel::Phong, SpecularModel::Blinn, SpecularModel::CookTorrance][k % 3];
+                (m.ks, m.shininess, m.roughness) = (0.6, 5.0 + 20.0 * (k % 4) as f32, 0.3);
+            }
+            scene.set_materials(materials).unwrap();
+            let view = View::new(&scene.camera);
+            let samples: Vec<_> = scene.lights.iter().map(Light::samples).collect();
+            let shader = Shader::new(&scene, &view, &samples);
+            let (runs, _) = resolve_frame(&scene, VisibilityMethod::Scanline);
+            let mut rs = RunShading::default();
+            for (y, run) in runs.lines.iter().enumerate().flat_map(|(y, l)| l.iter().map(move |r| (y as u32, r))) {
+                let n = (run.x1 - run.x0) as usize;
+                let lit: Vec<f32> = (0..n).map(|i| [1.0, 0.0, 0.5, 1.0, 0.25][(i + y as usize) % 5]).collect();
+                for (l, s) in samples.iter().enumerate().flat_map(|(l, s)| (0..s.len()).map(move |s| (l, s))) {
+                    let (mut fast, mut slow) = (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]);
+                    shader.begin_run(run, y, &mut rs);
+                    let lanes =
+                        rs.in_lanes && (rs.mode == ShadingMode::Gouraud || shader.lane_light_for(&rs, l, s).is_some());
+                    (in_lanes, in_f64) = if lanes { (in_lanes + 1, in_f64) } else { (in_lanes, in_f64 + 1) };
+                    shader.add_light(&mut rs, l, s, &lit);
+                    shader.finish_run(&rs, &mut fast);
+                    shader.begin_run(run, y, &mut rs);
+                    rs.in_lanes = false;
+                    if !rs.f64_ready {
+                        shader.prepare_f64(&mut rs);
+                    }
+                    shader.add_light(&mut rs, l, s, &lit);
+                    shader.finish_run(&rs, &mut slow);
+                    for (a, b) in fast.iter().zip(&slow) {
+                        let err = (*a - *b).abs().max_element() / b.abs().max_element().max(1.0);
+                        assert!(err < 2e-5, "seed {seed}, line {y}, {run:?}: lanes {a} f64 {b}");
+                        worst = worst.max(err);
+                    }
+                }
+            }
+        }
+        assert!(in_lanes > 1000 && in_f64 > 50, "{in_lanes} runs in lanes, {in_f64} in f64");
+        eprintln!("worst difference {worst:e} over {in_lanes} runs in lanes");
+    }
+
+    fn mat(model: SpecularModel) -> Material {
+        Material { model, ks: 1.0, kd: 0.0, ..Material::new("m") }
+    }
+
+    #[test]
+    fn specular_is_zero_below_the_horizon() {
+        let m = mat(SpecularModel::Phong);
+        assert_eq!(reflect(&m, DVec3::Y, DVec3::Y, -DVec3::Y), Vec3::ZERO);
+    }
+
+    #[test]
+    fn cook_torrance_by_hand() {
+        // N = V = L = +Y: H = N, alpha = 0, D = 1/(π m²), F = F0, G = 1,
+        // spec = π D F G / (4 N.V) = F0 / (4 m²).
+        let m = Material { roughness: 0.5, fresnel: 0.04, ..mat(SpecularModel::CookTorrance) };
+        let s = reflect(&m, DVec3::Y, DVec3::Y, DVec3::Y);
+        assert!((s.x - 0.04 / (4.0 * 0.25)).abs() < 1e-6, "{s}");
+        // L at 60° from N in the plane of V = N: H at 30°.
+        let l = DVec3::new(60f64.to_radians().sin(), 60f64.to_radians().cos(), 0.0);
+        let h = (l + DVec3::Y).normalize();
+        let (nh, vh, nl, nv) = (h.y, h.y, l.y, 1.0);
+        let tan2 = (1.0 - nh * nh) / (nh * nh);
+        let d = (-tan2 / 0.25).exp() / (PI * 0.25 * nh.powi(4));
+        let f = 0.04 + 0.96 * (1.0 - vh).powi(5);
+        let g = (2.0 * nh * nv / vh).min(2.0 * nh * nl / vh).min(1.0);
+        let want = PI * d * f * g / (4.0 * nv);
+        let s = reflect(&m, DVec3::Y, DVec3::Y, l);
+        assert!((s.x as f64 - want).abs() < 1e-6, "{s} vs {want}");
+    }
+
+    #[test]
+    fn blinn_with_four_times_the_exponent_matches_phong_near_the_peak() {
+        // Coplanar N, L, V: the angle between N and H is half that between R and V, so
+        // (N.H)^(4n) ≈ (R.V)^n for small angles.
+        let phong = Material { shininess: 20.0, ..mat(SpecularModel::Phong) };
+        let blinn = Material { shininess: 80.0, ..mat(SpecularModel::Blinn) };
+        let l = DVec3::new(-0.5, 1.0, 0.0).normalize();
+        for deg in [0.0f64, 2.0, 5.0, 8.0] {
+            let r = DVec3::new(0.5, 1.0, 0.0).normalize();
+            let v = glam::DQuat::from_rotation_z(deg.to_radians()) * r;
+            let (p, b) = (reflect(&phong, DVec3::Y, v, l).x, reflect(&blinn, DVec3::Y, v, l).x);
+            assert!((p - b).abs() < 0.03, "{deg}°: phong {p} blinn {b}");
+        }
+    }
+
+    #[test]
+    fn attenuation_and_spot_cone() {
+        let light = Light {
+            kind: LightKind::Spot {
+                position: DVec3::new(0.0, 2.0, 0.0),
+                direction: -DVec3::Y,
+                cutoff: 30.0,
+                exponent: 2.0,
+            },
+            color: Vec3::ONE,
+            intensity: 1.0,
+            attenuation: [1.0, 0.5, 0.25],
+        };
+        let s = light.samples()[0];
+        // Straight below at distance 2: f_att = 1/(1 + 1 + 1) = 1/3, spot = 1.
+        let (_, r) = incident(&light, &s, 1, DVec3::ZERO);
+        assert!((r.x - 1.0 / 3.0).abs() < 1e-6);
+        // 20° off axis: inside; cos^2.
+        let p = DVec3::new(2.0 * 20f64.to_radians().tan(), 0.0, 0.0);
+        let d = (p - DVec3::new(0.0, 2.0, 0.0)).length();
+        let (_, r) = incident(&light, &s, 1, p);
+        let want = 20f64.to_radians().cos().powi(2) / (1.0 + 0.5 * d + 0.25 * d * d);
+        assert!((r.x as f64 - want).abs() < 1e-6);
+        // 31° off axis: outside the cone.
+        let (_, r) = incident(&light, &s, 1, DVec3::new(2.0 * 31f64.to_radians().tan(), 0.0, 0.0));
+        assert_eq!(r, Vec3::ZERO);
+    }
+}
