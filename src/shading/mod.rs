@@ -240,9 +240,8 @@ impl<'a> Shader<'a> {
         let ns = self.view.ray(0.0, rs.yc).cross(self.view.r);
         rs.along = plane.n.cross(ns);
         rs.crossings.clear();
-        let n = verts.len();
-        for k in 0..n {
-            let (a, b) = (verts[k], verts[(k + 1) % n]);
+        // Each edge k -> k+1, the last one closing the ring (no division for the wrap).
+        for (k, (&a, &b)) in verts.iter().zip(verts[1..].iter().chain(&verts[..1])).enumerate() {
             let (da, db) = (ns.dot(a - eye), ns.dot(b - eye));
             if (da >= 0.0) != (db >= 0.0) {
                 let t = da / (da - db);
@@ -261,8 +260,8 @@ impl<'a> Shader<'a> {
         let step = self.view.ray_step();
         let depth = -plane.distance(self.view.eye);
         let den = [plane.n.dot(ray), plane.n.dot(step)];
-        let reach = |i: f64| ((ray + step * i) * (depth / (den[0] + i * den[1]))).length();
-        rs.reach = reach(0.0).max(reach((rs.len - 1) as f64));
+        let reach2 = |i: f64| ((ray + step * i) * (depth / (den[0] + i * den[1]))).length_squared();
+        rs.reach = reach2(0.0).max(reach2((rs.len - 1) as f64)).sqrt();
         if rs.reach.is_nan() || rs.reach >= LANE_REACH {
             return false;
         }
@@ -452,7 +451,7 @@ fn finite(c: Vec3) -> Vec3 {
 
 /// The value at a scan crossing, between its edge's two vertices' values.
 fn crossing_value<T>(values: &[T], c: ScanCrossing, get: impl Fn(&T) -> DVec3) -> DVec3 {
-    let next = (c.k as usize + 1) % values.len();
+    let next = if c.k as usize + 1 == values.len() { 0 } else { c.k as usize + 1 };
     get(&values[c.k as usize]) * (1.0 - c.t) + get(&values[next]) * c.t
 }
 
