@@ -99,7 +99,16 @@ pub struct EdgeTable {
     lines: Range<u32>,
     height: u32,
     built: bool,
+    /// The edges (indices into `edges`, increasing) that span more than [`LONG_EDGE`] lines:
+    /// with them, a band's first active edges are found without reading every edge above it.
+    long: Vec<u32>,
+    /// The sorted edges' last buffer, kept for the next frame's sort.
+    spare: Vec<Edge>,
 }
+
+/// An edge spanning at most this many lines that starts this far above a band has ended
+/// before it.
+const LONG_EDGE: u32 = 32;
 
 impl EdgeTable {
     /// An empty table for an image `height` lines high.
@@ -111,6 +120,7 @@ impl EdgeTable {
     pub fn clear(&mut self, height: u32) {
         self.edges.clear();
         self.bucket.clear();
+        self.long.clear();
         self.height = height;
         self.lines = 0..0;
         self.built = false;
@@ -159,13 +169,18 @@ impl EdgeTable {
             self.bucket[i + 1] += self.bucket[i];
         }
         let mut next = self.bucket.clone();
-        let mut sorted = vec![self.edges[0]; self.edges.len()];
+        let mut sorted = std::mem::take(&mut self.spare);
+        sorted.clear();
+        sorted.resize(self.edges.len(), self.edges[0]);
         for e in &self.edges {
             let slot = &mut next[(e.first - lo) as usize];
             sorted[*slot as usize] = *e;
             *slot += 1;
         }
-        self.edges = sorted;
+        self.spare = std::mem::replace(&mut self.edges, sorted);
+        self.long.clear();
+        let long = self.edges.iter().enumerate().filter(|(_, e)| e.end - e.first > LONG_EDGE);
+        self.long.extend(long.map(|(i, _)| i as u32));
     }
 
     /// Every edge as (tag, first line, end line, x at its top, y at its top, dx/dy).
@@ -175,7 +190,8 @@ impl EdgeTable {
 
     /// Bytes held by the table.
     pub fn bytes(&self) -> usize {
-        self.edges.capacity() * std::mem::size_of::<Edge>() + self.bucket.capacity() * 4
+        (self.edges.capacity() + self.spare.capacity()) * std::mem::size_of::<Edge>()
+            + (self.bucket.capacity() + self.long.capacity()) * 4
     }
 
     /// Number of edges.
@@ -218,8 +234,14 @@ impl<'a> ActiveEdges<'a> {
         let end = lines.end.min(table.lines.end);
         let mut active = Vec::new();
         if start > table.lines.start && start < end {
-            let upto = table.bucket[(start - table.lines.start) as usize] as usize;
-            for (i, e) in table.edges[..upto].iter().enumerate() {
+            let bucket = |line: u32| table.bucket[(line - table.lines.start) as usize] as usize;
+            let upto = bucket(start);
+            // Above `near`, only the long edges can reach `start`; taken in index order, the
+            // candidates are the same as reading every edge above `start`.
+            let near = bucket(start.saturating_sub(LONG_EDGE).max(table.lines.start));
+            let long = &table.long[..table.long.partition_point(|&i| (i as usize) < near)];
+            for i in long.iter().map(|&i| i as usize).chain(near..upto) {
+                let e = &table.edges[i];
                 if e.end > start {
                     active.push(Crossing { x: e.x_at(start), tag: e.tag, edge: i as u32 });
                 }
