@@ -488,15 +488,7 @@ pub(crate) fn walk_line(
 fn saturate(color: &mut [Vec3]) {
     for c in color {
         if !c.is_finite() {
-            *c = Vec3::new(fin(c.x), fin(c.y), fin(c.z));
+            *c = crate::shading::finite(*c);
         }
-    }
-}
-
-fn fin(x: f32) -> f32 {
-    if x.is_nan() {
-        f32::MAX
-    } else {
-        x.clamp(-f32::MAX, f32::MAX)
     }
 }

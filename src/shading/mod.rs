@@ -444,7 +444,7 @@ fn add_f64(light: &mut Vec<Vec3>, used: &mut bool, lit: &[f32], color: impl Fn(u
 
 /// A channel that overflowed (to infinity, or to not-a-number through infinity times zero
 /// or less infinity) becomes the largest finite value, as an overflow should look.
-fn finite(c: Vec3) -> Vec3 {
+pub(crate) fn finite(c: Vec3) -> Vec3 {
     let f = |x: f32| if x.is_nan() { f32::MAX } else { x.clamp(-f32::MAX, f32::MAX) };
     Vec3::new(f(c.x), f(c.y), f(c.z))
 }
