@@ -409,16 +409,14 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
             let (a, b) = (row + run.x0 as usize, row + run.x1 as usize);
             clear(gap..a, bg, color, id, &mut light);
             id[a..b].fill(ctx.scene.polygons[run.poly as usize].face);
-            for l in &mut light {
-                l[a..b].fill(0.0);
-            }
             shader.begin_run(run, y, &mut rs);
             for (k, (l, s, _)) in ctx.all_samples().enumerate() {
                 let at = k * w as usize;
                 let lit = &lit[at + run.x0 as usize..at + run.x1 as usize];
                 let share = 1.0 / ctx.samples[l].len() as f32;
+                // A light's first sample writes its lit fraction, the others add to it.
                 for (f, &v) in light[l][a..b].iter_mut().zip(lit) {
-                    *f += v * share;
+                    *f = if s == 0 { v * share } else { *f + v * share };
                 }
                 shader.add_light(&mut rs, l, s, lit);
             }

@@ -30,7 +30,7 @@ type V3 = [f32x8; 3];
 #[derive(Debug, Default)]
 pub(super) struct RunLanes {
     len: usize,
-    /// `s` between the two edge crossings, in `[0, 1]`.
+    /// `s` between the two edge crossings, in `[0, 1]` (Gouraud mode).
     s: Vec<f32x8>,
     /// `p − eye`, the unit normal turned toward the viewer, and the unit vector to the eye
     /// (Phong mode only).
@@ -167,8 +167,11 @@ impl RunLanes {
                 / i.mul_add(f32x8::splat(g.s_div[1]), f32x8::splat(g.s_div[0]));
             // Not-a-number (a zero divisor) fails the first test and becomes 0.
             let s = s.simd_ge(f32x8::ZERO).select(s, f32x8::ZERO).min(f32x8::ONE);
-            self.s.push(s);
-            let Some([left, right, plane]) = g.normals else { continue };
+            // Gouraud keeps `s`; Phong keeps what it interpolates with it.
+            let Some([left, right, plane]) = g.normals else {
+                self.s.push(s);
+                continue;
+            };
             let t = f32x8::splat(g.depth) / i.mul_add(f32x8::splat(g.den[1]), f32x8::splat(g.den[0]));
             let q = [0, 1, 2].map(|c| i.mul_add(f32x8::splat(g.step[c]), f32x8::splat(g.ray[c])) * t);
             let n = [0, 1, 2].map(|c| s.mul_add(f32x8::splat(right[c] - left[c]), f32x8::splat(left[c])));

@@ -131,7 +131,7 @@ pub(crate) struct Shader<'a> {
     view: &'a View,
     samples: &'a [Vec<LightSample>],
     /// Each light sample as the lane kernels see it, with its position for point samples.
-    lane_lights: Vec<Vec<(LaneLight, Option<DVec3>)>>,
+    lane_lights: Vec<Vec<(LaneLight, Option<PointAt>)>>,
     /// Each material as the lane kernels see it.
     lane_materials: Vec<LaneMaterial>,
 }
@@ -179,6 +179,9 @@ struct ScanCrossing {
     k: u32,
     t: f64,
 }
+
+/// A point light sample's position, and its distance from the eye.
+type PointAt = (DVec3, f64);
 
 /// Lanes take runs whose points lie within this distance of the eye, so that squared
 /// lengths stay far inside single precision.
@@ -417,9 +420,9 @@ impl<'a> Shader<'a> {
         let ok = rs.in_lanes
             && match position {
                 None => true,
-                Some(p) => {
+                Some((p, from_eye)) => {
                     let plane = &self.scene.polygons[rs.poly].plane;
-                    let far = (*p - self.view.eye).length() + rs.reach;
+                    let far = from_eye + rs.reach;
                     far < LANE_REACH && far < LANE_RATIO * plane.distance(*p).abs()
                 }
             };
@@ -455,11 +458,11 @@ fn crossing_value<T>(values: &[T], c: ScanCrossing, get: impl Fn(&T) -> DVec3) -
     get(&values[c.k as usize]) * (1.0 - c.t) + get(&values[next]) * c.t
 }
 
-/// A light sample as the lanes see it, and where it is when it is a point.
-fn lane_light(light: &Light, sample: &LightSample, samples: usize, eye: DVec3) -> (LaneLight, Option<DVec3>) {
+/// A light sample as the lanes see it, and, for a point, where it is and how far from the eye.
+fn lane_light(light: &Light, sample: &LightSample, samples: usize, eye: DVec3) -> (LaneLight, Option<PointAt>) {
     let f32s = |v: DVec3| v.as_vec3().to_array();
     let (toward, position) = match *sample {
-        LightSample::Point(p) => (Toward::Point(f32s(p - eye)), Some(p)),
+        LightSample::Point(p) => (Toward::Point(f32s(p - eye)), Some((p, (p - eye).length()))),
         LightSample::Directional(d) => (Toward::Direction(f32s(-d)), None),
     };
     let spot = match light.kind {
