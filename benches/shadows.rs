@@ -43,7 +43,7 @@ fn stages(c: &mut Criterion) {
             methods.push(("atherton-weiler-greenberg", ShadowMethod::AthertonWeilerGreenberg));
             methods.push((
                 "bouknight-kelley-no-prefilter",
-                ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false }),
+                ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false, ..Default::default() }),
             ));
         }
         for (label, m) in methods {

@@ -59,6 +59,10 @@ struct ShadowArgs {
     /// Bouknight-Kelley: project every pair, without the sphere prefilter (to measure it).
     #[arg(long)]
     no_prefilter: bool,
+    /// Bouknight-Kelley: keep the polygons of closed solids that face away from the light
+    /// as casters, as the paper does (to measure what dropping them saves).
+    #[arg(long)]
+    no_solid_cull: bool,
     /// Crow and stencil-volume: count shadow volumes from the eye with the eye's own count
     /// (zpass), from infinity (zfail), or from zero at the eye (naive-zpass, wrong when the
     /// eye is in shadow).
@@ -140,9 +144,10 @@ impl ShadowArgs {
         };
         let volumes = VolumeOptions { counting: self.crow_count, silhouettes: !self.no_silhouettes };
         match method {
-            ShadowMethod::BouknightKelley(_) => {
-                ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: !self.no_prefilter })
-            }
+            ShadowMethod::BouknightKelley(_) => ShadowMethod::BouknightKelley(BouknightKelleyOptions {
+                prefilter: !self.no_prefilter,
+                solid_cull: !self.no_solid_cull,
+            }),
             ShadowMethod::Crow(_) => ShadowMethod::Crow(volumes),
             ShadowMethod::StencilVolume(_) => ShadowMethod::StencilVolume(volumes),
             ShadowMethod::Williams(_) => ShadowMethod::Williams(WilliamsOptions {

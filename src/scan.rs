@@ -67,8 +67,28 @@ pub struct Crossing {
     pub x: f64,
     /// The tag of the polygon the edge belongs to.
     pub tag: u32,
-    /// The edge (its index in the table).
-    edge: u32,
+    /// The line after the edge's last.
+    end: u32,
+    /// The edge's line equation, carried along so that stepping to the next line reads the
+    /// active list alone, in order, not the table at scattered places.
+    x_top: f64,
+    y_top: f64,
+    dxdy: f64,
+}
+
+impl Crossing {
+    /// Edge `e`'s crossing with `line`.
+    #[inline]
+    fn of(e: &Edge, line: u32) -> Crossing {
+        Crossing { x: e.x_at(line), tag: e.tag, end: e.end, x_top: e.x_top, y_top: e.y_top, dxdy: e.dxdy }
+    }
+
+    /// The same edge's crossing with `line`: the same arithmetic as [`Edge::x_at`], so the
+    /// same bits.
+    #[inline]
+    fn at(&self, line: u32) -> f64 {
+        self.x_top + (line as f64 + 0.5 - self.y_top) * self.dxdy
+    }
 }
 
 /// The first pixel whose centre lies at or right of `x`, clamped to `0..=width`:
@@ -243,7 +263,7 @@ impl<'a> ActiveEdges<'a> {
             for i in long.iter().map(|&i| i as usize).chain(near..upto) {
                 let e = &table.edges[i];
                 if e.end > start {
-                    active.push(Crossing { x: e.x_at(start), tag: e.tag, edge: i as u32 });
+                    active.push(Crossing::of(e, start));
                 }
             }
             active.sort_unstable_by(|a, b| a.x.total_cmp(&b.x));
@@ -267,14 +287,12 @@ impl<'a> ActiveEdges<'a> {
         }
         let line = self.next;
         self.next += 1;
-        let edges = &self.table.edges;
         // Edges whose last line has passed leave; the others step to this line (one pass).
         let mut kept = 0;
         for i in 0..self.active.len() {
             let mut c = self.active[i];
-            let e = &edges[c.edge as usize];
-            if e.end > line {
-                c.x = e.x_at(line);
+            if c.end > line {
+                c.x = c.at(line);
                 self.active[kept] = c;
                 kept += 1;
             }
@@ -292,16 +310,11 @@ impl<'a> ActiveEdges<'a> {
             self.active[j] = item;
         }
         // Edges that start on this line are sorted among themselves, then merged in.
-        let base = self.table.bucket.get((line - self.table.lines.start) as usize).copied().unwrap_or(0);
         let entering = self.table.starting_on(line);
         if !entering.is_empty() {
             self.entered += entering.len() as u64;
             self.incoming.clear();
-            self.incoming.extend(entering.iter().enumerate().map(|(k, e)| Crossing {
-                x: e.x_at(line),
-                tag: e.tag,
-                edge: base + k as u32,
-            }));
+            self.incoming.extend(entering.iter().map(|e| Crossing::of(e, line)));
             self.incoming.sort_unstable_by(|a, b| a.x.total_cmp(&b.x));
             self.merged.clear();
             let (mut a, mut b) = (self.active.iter().peekable(), self.incoming.iter().peekable());

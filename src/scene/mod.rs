@@ -4,8 +4,12 @@
 mod build;
 mod load;
 mod obj;
+mod solids;
 pub use build::SceneBuilder;
 pub(crate) use obj::ObjText;
+pub(crate) use solids::Solid;
+#[cfg(test)]
+pub(crate) use solids::NO_SOLID;
 mod write;
 
 pub use obj::parse_obj;
@@ -470,6 +474,10 @@ pub struct Scene {
     /// Unit vertex normals, parallel to `vertices`.
     pub(crate) normals: Vec<DVec3>,
     pub(crate) face_count: u32,
+    /// Each polygon's closed solid (an index into `solids`), or [`NO_SOLID`].
+    pub(crate) solid_of: Vec<u32>,
+    /// The closed, consistently wound surfaces among the objects' polygons.
+    pub(crate) solids: Vec<Solid>,
 }
 
 impl Scene {
@@ -518,6 +526,8 @@ impl Scene {
             vertices: Vec::new(),
             normals: Vec::new(),
             face_count: 0,
+            solid_of: Vec::new(),
+            solids: Vec::new(),
         };
         scene.compile().map_err(Error::InvalidOption)?;
         Ok(scene)
@@ -553,6 +563,9 @@ impl Scene {
             }
             let avg: Vec<DVec3> = rep.iter().map(|&r| avg[r]).collect();
             let mut pts = Vec::new();
+            // The object's polygons as (first vertex, count) from `v0`, and each vertex's
+            // welded position id: what finding its solids needs.
+            let (v0, mut ranges, mut keys) = (self.vertices.len() as u32, Vec::new(), Vec::new());
             for (fi, f) in mesh.faces.iter().enumerate() {
                 let face = self.face_count + fi as u32;
                 pts.clear();
@@ -571,7 +584,9 @@ impl Scene {
                     for &k in idx {
                         self.vertices.push(pts[k]);
                         self.normals.push(normal(k, &plane));
+                        keys.push(rep[f.vertices[k] as usize] as u32);
                     }
+                    ranges.push((start - v0, idx.len() as u32));
                     self.polygons.push(Polygon { face, object: oi as u32, start, len: idx.len() as u32, plane });
                 };
                 match classify_face(&pts) {
@@ -585,6 +600,10 @@ impl Scene {
                 }
             }
             self.face_count += mesh.faces.len() as u32;
+            let corners = solids::Corners { ranges: &ranges, keys: &keys, verts: &self.vertices[v0 as usize..] };
+            let (of, found) = solids::find(&corners, self.solids.len() as u32);
+            self.solid_of.extend(of);
+            self.solids.extend(found);
         }
         Ok(())
     }

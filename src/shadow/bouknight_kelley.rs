@@ -33,7 +33,7 @@
 //! light; zero-area projections are dropped. None of these divide by zero.
 
 use super::overlay::{Interval, Overlay, OverlayWalker};
-use super::projection::{bounding_rectangle, edge_on, light_side, Projector};
+use super::projection::{bounding_rectangle, edge_on, faces_away_on_solid, light_side, Projector};
 use super::{
     BouknightKelleyOptions, Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker,
 };
@@ -93,9 +93,13 @@ fn shadow_polygons(
     let receivers: Vec<u32> = (0..n as u32)
         .filter(|&i| ctx.visible[i as usize] && sample.on_seen_side(&scene.polygons[i as usize].plane, ctx.view.eye))
         .collect();
-    let casters: Vec<u32> = (0..n as u32)
-        .filter(|&i| scene.casts_shadows(i as usize) && !edge_on(scene, i as usize, sample, ctx.extent))
-        .collect();
+    let casting = |i: usize| scene.casts_shadows(i) && !edge_on(scene, i, sample, ctx.extent);
+    let culled = |i: usize| options.solid_cull && faces_away_on_solid(scene, i, sample);
+    let casters: Vec<u32> = (0..n as u32).filter(|&i| casting(i as usize) && !culled(i as usize)).collect();
+    if options.solid_cull {
+        let dropped = (0..n).filter(|&i| casting(i) && culled(i)).count();
+        counters.add("casters_dropped_facing_away", dropped as u64);
+    }
     counters.add("receivers", receivers.len() as u64);
     counters.add("casters", casters.len() as u64);
     counters.add("pairs_with_roles", receivers.len() as u64 * casters.len() as u64);
@@ -187,22 +191,22 @@ fn merge(
     ctx: &ShadowContext,
     per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>, Pairs)>,
 ) -> (Overlay, Tally, FxHashMap<u32, Pairs>) {
-    let mut overlay = Overlay::new(ctx.view.height, ctx.keep_outlines);
     let mut total = Tally::default();
     let mut kept_pairs = FxHashMap::default();
+    let mut receivers = Vec::with_capacity(per_receiver.len());
+    let mut tag = 0;
     for (b, tally, rings, mut pairs) in per_receiver {
         total.add(&tally);
-        for (i, r) in rings.iter().enumerate() {
-            let tag = overlay.add(b, r);
-            if let Some(p) = pairs.shadow_polygons.get_mut(i) {
-                p.0 = tag;
-            }
+        for (i, p) in pairs.shadow_polygons.iter_mut().enumerate() {
+            p.0 = tag + i as u32;
         }
+        tag += rings.len() as u32;
         if ctx.keep_outlines {
             kept_pairs.insert(b, pairs);
         }
+        receivers.push((b, rings));
     }
-    overlay.finish();
+    let overlay = Overlay::from_receivers(ctx.view.height, ctx.keep_outlines, &receivers);
     (overlay, total, kept_pairs)
 }
 
@@ -253,7 +257,7 @@ struct SphereGrid {
 impl SphereGrid {
     fn new(scene: &Scene, sample: LightSample, casters: &[u32]) -> Self {
         let n = scene.polygons.len();
-        let extents: Vec<Extent> = (0..n).map(|i| extent(scene.verts(i), sample)).collect();
+        let extents: Vec<Extent> = (0..n).into_par_iter().map(|i| extent(scene.verts(i), sample)).collect();
         let domain = match sample {
             LightSample::Point(_) => [0.0, -PI, PI, PI],
             LightSample::Directional(_) => extents

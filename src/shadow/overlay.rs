@@ -11,6 +11,7 @@ use super::{Cover, Decision, Detail, ShadowContext, ShadowWalker};
 use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::visibility::Run;
 use glam::DVec2;
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::ops::Range;
 
@@ -67,6 +68,33 @@ impl Overlay {
         tag
     }
 
+    /// An overlay of single-ring polygons given receiver by receiver (each receiver once),
+    /// tagged in the order given; the receivers' edge tables are built in parallel.
+    pub fn from_receivers(height: u32, keep_rings: bool, receivers: &[(u32, Vec<Vec<DVec2>>)]) -> Self {
+        let receivers: Vec<&(u32, Vec<Vec<DVec2>>)> = receivers.iter().filter(|r| !r.1.is_empty()).collect();
+        let mut first = Vec::with_capacity(receivers.len());
+        let mut count = 0;
+        for r in &receivers {
+            first.push(count as u32);
+            count += r.1.len();
+        }
+        let tables = receivers
+            .par_iter()
+            .zip(&first)
+            .map(|(r, &t0)| {
+                let mut table = EdgeTable::new(height);
+                for (k, ring) in r.1.iter().enumerate() {
+                    table.add_ring(t0 + k as u32, ring);
+                }
+                table.finish();
+                table
+            })
+            .collect();
+        let slot = receivers.iter().enumerate().map(|(i, r)| (r.0, i as u32)).collect();
+        let rings = if keep_rings { receivers.iter().flat_map(|r| r.1.iter().cloned()).collect() } else { Vec::new() };
+        Overlay { height, tables, slot, count, rings, keep_rings }
+    }
+
     /// Sorts the edge tables; call once after the last `add`.
     pub fn finish(&mut self) {
         for t in &mut self.tables {
@@ -91,6 +119,7 @@ impl Overlay {
             end: lines.end,
             line: lines.start,
             active: (0..self.tables.len()).map(|_| None).collect(),
+            lines: vec![LineIntervals::default(); self.tables.len()],
             open: OpenSet::sparse(),
         }
     }
@@ -103,7 +132,19 @@ pub struct OverlayWalker<'a> {
     end: u32,
     line: u32,
     active: Vec<Option<ActiveEdges<'a>>>,
+    /// Each receiver's intervals on the line it was last asked about.
+    lines: Vec<LineIntervals>,
     open: OpenSet,
+}
+
+/// One receiver's intervals on one line, whole (not clipped to a run), ordered by where they
+/// start, with the furthest end reached so far at each: a receiver seen in many runs on a
+/// line pairs its crossings once, and each run reads only the intervals that can reach it.
+#[derive(Debug, Clone, Default)]
+struct LineIntervals {
+    line: Option<u32>,
+    all: Vec<Interval>,
+    reach: Vec<u32>,
 }
 
 impl OverlayWalker<'_> {
@@ -119,17 +160,42 @@ impl OverlayWalker<'_> {
         let Some(&slot) = self.overlay.slot.get(&receiver) else { return };
         let table = &self.overlay.tables[slot as usize];
         let (line, end) = (self.line, self.end);
-        let aet = self.active[slot as usize].get_or_insert_with(|| ActiveEdges::new(table, line..end));
-        self.open.clear();
-        for c in aet.advance_to(line) {
-            if let Some(start) = self.open.toggle(c.tag, boundary(c.x, u32::MAX)) {
-                let (start, end) = (start.max(x0), boundary(c.x, u32::MAX).min(x1));
-                if start < end {
-                    out.push(Interval { start, end, tag: c.tag });
+        let cached = &mut self.lines[slot as usize];
+        if cached.line != Some(line) {
+            let aet = self.active[slot as usize].get_or_insert_with(|| ActiveEdges::new(table, line..end));
+            cached.pair(aet.advance_to(line), &mut self.open);
+            cached.line = Some(line);
+        }
+        // The intervals starting before the run's end, from the first whose reach passes
+        // its start.
+        let from = cached.reach.partition_point(|&r| r <= x0);
+        for iv in cached.all[from..].iter().take_while(|iv| iv.start < x1).filter(|iv| iv.end > x0) {
+            out.push(Interval { start: iv.start.max(x0), end: iv.end.min(x1), tag: iv.tag });
+        }
+        out.sort_unstable_by_key(|i| (i.start, i.end, i.tag));
+    }
+}
+
+impl LineIntervals {
+    /// Pairs a line's crossings (sorted by x) into each polygon's covered intervals.
+    fn pair(&mut self, crossings: &[crate::scan::Crossing], open: &mut OpenSet) {
+        self.all.clear();
+        open.clear();
+        for c in crossings {
+            let at = boundary(c.x, u32::MAX);
+            if let Some(start) = open.toggle(c.tag, at) {
+                if start < at {
+                    self.all.push(Interval { start, end: at, tag: c.tag });
                 }
             }
         }
-        out.sort_unstable_by_key(|i| (i.start, i.end));
+        self.all.sort_unstable_by_key(|i| (i.start, i.end, i.tag));
+        self.reach.clear();
+        let mut far = 0;
+        self.reach.extend(self.all.iter().map(|iv| {
+            far = far.max(iv.end);
+            far
+        }));
     }
 }
 

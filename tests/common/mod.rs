@@ -51,7 +51,11 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
         ("bouknight-kelley".into(), ShadowMethod::BouknightKelley(BouknightKelleyOptions::default())),
         (
             "bouknight-kelley --no-prefilter".into(),
-            ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false }),
+            ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false, solid_cull: true }),
+        ),
+        (
+            "bouknight-kelley --no-solid-cull".into(),
+            ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: true, solid_cull: false }),
         ),
         ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg),
         ("crow zpass".into(), ShadowMethod::Crow(volumes(Counting::ZPass))),

@@ -1,0 +1,236 @@
+//! Closed solids: the parts of an object whose polygons close up into a watertight,
+//! consistently wound surface. Found once, when a scene compiles, so that shadow stages can
+//! drop the polygons of a solid that face away from a light (see
+//! `docs/bouknight-kelley.md`, "Speed").
+//!
+//! A *solid* is a connected set of an object's polygons in which every edge (between welded
+//! vertex positions) is used by exactly two polygons, once in each direction. Its *sign* is
+//! the sign of the volume it encloses: +1 when its polygons' front sides face out, −1 when
+//! they face in. A segment from a point outside the solid's bounds to any point crosses the
+//! surface first from the side its normals point to when the sign is +1 (from the other side
+//! when −1), so the first polygon of the solid that such a segment meets always has the
+//! outside point on the side the sign names. This needs the surface not to pass through
+//! itself with parts turned inside out (a self-intersecting mesh whose winding goes
+//! negative), which a scanned or modelled closed mesh does not do.
+
+use glam::DVec3;
+
+/// No solid: the polygon is on an open or non-manifold part of its mesh.
+pub(crate) const NO_SOLID: u32 = u32::MAX;
+
+/// One closed, consistently wound surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Solid {
+    /// +1 when the polygons' front sides face out of the enclosed volume, −1 when in.
+    pub sign: f64,
+    /// Its bounding box.
+    pub lo: DVec3,
+    pub hi: DVec3,
+}
+
+impl Solid {
+    /// Whether `p` lies outside the solid's bounding box (so outside the solid).
+    pub fn outside(&self, p: DVec3) -> bool {
+        p.cmplt(self.lo).any() || p.cmpgt(self.hi).any()
+    }
+}
+
+/// One polygon's corners: `keys[start..start+len]` (welded vertex ids) and the same range of
+/// `verts`.
+pub(crate) struct Corners<'a> {
+    pub ranges: &'a [(u32, u32)],
+    pub keys: &'a [u32],
+    pub verts: &'a [DVec3],
+}
+
+/// The solids among one object's polygons: for each polygon its solid's index in the returned
+/// list (offset by `first`), or [`NO_SOLID`].
+pub(crate) fn find(corners: &Corners, first: u32) -> (Vec<u32>, Vec<Solid>) {
+    let n = corners.ranges.len();
+    let mut sets = DisjointSets::new(n);
+    let mut open = vec![false; n];
+    pair_edges(corners, &mut sets, &mut open);
+    for p in 0..n {
+        if open[p] {
+            let r = sets.root(p);
+            open[r] = true;
+        }
+    }
+    // One solid per closed component, in the order of its first polygon.
+    let mut index = vec![NO_SOLID; n];
+    let mut volume: Vec<(f64, DVec3, DVec3, DVec3)> = Vec::new();
+    let mut of = vec![NO_SOLID; n];
+    for (p, &(start, len)) in corners.ranges.iter().enumerate() {
+        let r = sets.root(p);
+        if open[r] {
+            continue;
+        }
+        let v = &corners.verts[start as usize..(start + len) as usize];
+        if index[r] == NO_SOLID {
+            index[r] = volume.len() as u32;
+            volume.push((0.0, v[0], v[0], v[0]));
+        }
+        let s = &mut volume[index[r] as usize];
+        // Six times the signed volume of the cone from the component's first corner.
+        let o = s.1;
+        for k in 1..v.len() - 1 {
+            s.0 += (v[0] - o).dot((v[k] - o).cross(v[k + 1] - o));
+        }
+        for &q in v {
+            s.2 = s.2.min(q);
+            s.3 = s.3.max(q);
+        }
+        of[p] = index[r];
+    }
+    // A component that encloses (next to) no volume has no inside to speak of.
+    let sign: Vec<f64> = volume
+        .iter()
+        .map(|&(vol, _, lo, hi)| {
+            let size = (hi - lo).length();
+            if vol.abs() > 1e-9 * size * size * size {
+                vol.signum()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut renumber = vec![NO_SOLID; volume.len()];
+    let mut solids = Vec::new();
+    for (i, &(_, _, lo, hi)) in volume.iter().enumerate() {
+        if sign[i] != 0.0 {
+            renumber[i] = first + solids.len() as u32;
+            solids.push(Solid { sign: sign[i], lo, hi });
+        }
+    }
+    for s in &mut of {
+        if *s != NO_SOLID {
+            *s = renumber[*s as usize];
+        }
+    }
+    (of, solids)
+}
+
+/// Joins the polygons that share an edge and marks `open` those with an edge that is not
+/// shared by exactly one other polygon running the other way.
+fn pair_edges(corners: &Corners, sets: &mut DisjointSets, open: &mut [bool]) {
+    // Each edge as (lesser key, greater key, runs from the greater, polygon).
+    let mut edges = Vec::new();
+    for (p, &(start, len)) in corners.ranges.iter().enumerate() {
+        let keys = &corners.keys[start as usize..(start + len) as usize];
+        for k in 0..keys.len() {
+            let (a, b) = (keys[k], keys[(k + 1) % keys.len()]);
+            if a == b {
+                open[p] = true;
+                continue;
+            }
+            edges.push((a.min(b), a.max(b), a > b, p as u32));
+        }
+    }
+    edges.sort_unstable();
+    let mut i = 0;
+    while i < edges.len() {
+        let (a, b) = (edges[i].0, edges[i].1);
+        let mut j = i;
+        while j < edges.len() && edges[j].0 == a && edges[j].1 == b {
+            j += 1;
+        }
+        let group = &edges[i..j];
+        if group.len() == 2 && group[0].2 != group[1].2 {
+            sets.join(group[0].3 as usize, group[1].3 as usize);
+        } else {
+            for e in group {
+                open[e.3 as usize] = true;
+            }
+        }
+        i = j;
+    }
+}
+
+/// Union-find over polygon indices.
+struct DisjointSets {
+    parent: Vec<u32>,
+}
+
+impl DisjointSets {
+    fn new(n: usize) -> Self {
+        DisjointSets { parent: (0..n as u32).collect() }
+    }
+
+    fn root(&mut self, mut i: usize) -> usize {
+        while self.parent[i] as usize != i {
+            let up = self.parent[self.parent[i] as usize];
+            self.parent[i] = up;
+            i = up as usize;
+        }
+        i
+    }
+
+    fn join(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.root(a), self.root(b));
+        if ra != rb {
+            self.parent[ra.max(rb)] = ra.min(rb) as u32;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scene::{Camera, Material, Mesh, Object, Scene, NO_SOLID};
+    use glam::DVec3;
+
+    fn cube(flip: bool, at: DVec3) -> Vec<Vec<DVec3>> {
+        let c = |x: f64, y: f64, z: f64| at + DVec3::new(x, y, z);
+        let mut faces = vec![
+            vec![c(0., 0., 0.), c(0., 1., 0.), c(1., 1., 0.), c(1., 0., 0.)],
+            vec![c(0., 0., 1.), c(1., 0., 1.), c(1., 1., 1.), c(0., 1., 1.)],
+            vec![c(0., 0., 0.), c(1., 0., 0.), c(1., 0., 1.), c(0., 0., 1.)],
+            vec![c(0., 1., 0.), c(0., 1., 1.), c(1., 1., 1.), c(1., 1., 0.)],
+            vec![c(0., 0., 0.), c(0., 0., 1.), c(0., 1., 1.), c(0., 1., 0.)],
+            vec![c(1., 0., 0.), c(1., 1., 0.), c(1., 1., 1.), c(1., 0., 1.)],
+        ];
+        if flip {
+            faces.iter_mut().for_each(|f| f.reverse());
+        }
+        faces
+    }
+
+    fn scene(objects: &[Vec<Vec<DVec3>>]) -> Scene {
+        let mut b = Scene::builder(Camera::new(DVec3::new(0.0, 0.0, 9.0), DVec3::ZERO)).material(Material::new("m"));
+        for o in objects {
+            b = b.object(Object::new(Mesh::from_polygons(o)), "m");
+        }
+        b.build().unwrap()
+    }
+
+    /// A cube is one solid, signed by its winding; two cubes in one object are two solids;
+    /// a cube missing a face, or with one face wound the wrong way, is none.
+    #[test]
+    fn closed_consistently_wound_components_are_solids_with_their_winding_as_sign() {
+        let s = scene(&[cube(false, DVec3::ZERO), cube(true, DVec3::X * 3.0)]);
+        assert_eq!(s.solids.len(), 2);
+        assert_eq!((s.solids[0].sign, s.solids[1].sign), (1.0, -1.0));
+        assert!(s.solid_of[..6].iter().all(|&i| i == 0) && s.solid_of[6..].iter().all(|&i| i == 1));
+        assert_eq!((s.solids[1].lo, s.solids[1].hi), (DVec3::X * 3.0, DVec3::new(4.0, 1.0, 1.0)));
+
+        let mut two = cube(false, DVec3::ZERO);
+        two.extend(cube(false, DVec3::Y * 2.0));
+        let s = scene(&[two]);
+        assert_eq!(s.solids.len(), 2);
+
+        let mut open = cube(false, DVec3::ZERO);
+        open.pop();
+        let mut wrong = cube(false, DVec3::ZERO);
+        wrong[2].reverse();
+        let s = scene(&[open, wrong]);
+        assert!(s.solids.is_empty() && s.solid_of.iter().all(|&i| i == NO_SOLID));
+    }
+
+    /// Two closed cubes that share a face (four polygons on one edge) are not solids.
+    #[test]
+    fn an_edge_used_more_than_twice_is_not_closed() {
+        let mut two = cube(false, DVec3::ZERO);
+        two.extend(cube(false, DVec3::X));
+        let s = scene(&[two]);
+        assert!(s.solids.is_empty());
+    }
+}
