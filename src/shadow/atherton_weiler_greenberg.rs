@@ -24,7 +24,7 @@
 //! per sample; the lit fraction is the share of samples that light a point.
 
 use super::overlay::{CoverWalker, Overlay};
-use super::projection::edge_on;
+use super::projection::{edge_on, faces_away_on_solid};
 use super::{ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::weiler_atherton::{clip, ClipError, Region};
@@ -89,6 +89,17 @@ struct Pass1 {
     clips: u64,
     depth_max: u64,
     splits: u64,
+    tiles: u64,
+}
+
+impl Pass1 {
+    fn add(&mut self, o: &Pass1) {
+        self.fragments += o.fragments;
+        self.clips += o.clips;
+        self.splits += o.splits;
+        self.tiles += o.tiles;
+        self.depth_max = self.depth_max.max(o.depth_max);
+    }
 }
 
 /// How a piece lies relative to a clip polygon over the piece's own area.
@@ -375,7 +386,10 @@ fn lit_in_view(
 ) -> std::result::Result<Vec<DetailPolygon>, ClipError> {
     let (mut casters, mut others) = (Vec::new(), Vec::new());
     for (i, poly) in scene.polygons.iter().enumerate() {
-        if edge_on(scene, i, sample, extent) {
+        // A light in the polygon's plane gives it no lit area and no shadow; a closed
+        // solid's polygon turned away from the light is unlit, and hides nothing its
+        // solid's polygons turned to the light do not (ours, not the paper's).
+        if edge_on(scene, i, sample, extent) || faces_away_on_solid(scene, i, sample) {
             continue;
         }
         let Some((ring, near)) = view.map(scene.verts(i), &poly.plane, 1e-9 * extent) else { continue };
@@ -386,6 +400,110 @@ fn lit_in_view(
             others.push(piece);
         }
     }
+    let pieces = if casters.len() + others.len() < 2 * TILE_PIECES {
+        lit_pieces(scene, casters, others, stats)?
+    } else {
+        // Independent regions of the view, sorted in parallel.
+        let tiles = Tiles::over(&casters, &others);
+        let lists: Vec<(Vec<Piece>, Vec<Piece>)> = tiles.split(casters).into_iter().zip(tiles.split(others)).collect();
+        stats.tiles += lists.len() as u64;
+        let done: Vec<(Vec<Piece>, Pass1)> = lists
+            .into_par_iter()
+            .map(|(casters, others)| {
+                let mut st = Pass1::default();
+                Ok((lit_pieces(scene, casters, others, &mut st)?, st))
+            })
+            .collect::<std::result::Result<_, ClipError>>()?;
+        let mut pieces = Vec::new();
+        for (lit, st) in done {
+            pieces.extend(lit);
+            stats.add(&st);
+        }
+        pieces
+    };
+    Ok(pieces
+        .into_iter()
+        .map(|p| {
+            let plane = scene.polygons[p.source as usize].plane;
+            let rings = p.region.rings.iter().map(|r| r.iter().map(|&q| view.unmap(q, &plane)).collect()).collect();
+            DetailPolygon { source: p.source, rings }
+        })
+        .collect())
+}
+
+/// Pieces per region of a light view, on average, when the view is cut into regions.
+const TILE_PIECES: usize = 128;
+
+/// A grid of rectangles over a light view (ours, not the paper's): each rectangle's pieces,
+/// cut to it, are sorted on their own, since what hides what inside one rectangle depends
+/// only on what lies in it. A large polygon behind many small ones (a floor under a crowd)
+/// is then clipped only by those over each rectangle, not by all of them in turn, and the
+/// rectangles are sorted in parallel.
+struct Tiles {
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+}
+
+impl Tiles {
+    fn over(casters: &[Piece], others: &[Piece]) -> Tiles {
+        let all = casters.iter().chain(others);
+        let (lo, hi) =
+            all.map(|p| p.bounds).fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+        let g = (((casters.len() + others.len()) as f64 / TILE_PIECES as f64).sqrt().ceil() as usize).clamp(1, 64);
+        let cuts = |lo: f64, hi: f64| {
+            (0..=g).map(|k| if k == g { hi } else { lo + (hi - lo) * k as f64 / g as f64 }).collect()
+        };
+        Tiles { xs: cuts(lo.x, hi.x), ys: cuts(lo.y, hi.y) }
+    }
+
+    /// The tiles (column-major) whose rectangles `pieces` overlap, with each piece cut to
+    /// each rectangle it crosses (a piece inside one rectangle is kept whole).
+    fn split(&self, pieces: Vec<Piece>) -> Vec<Vec<Piece>> {
+        let g = self.xs.len() - 1;
+        let mut out = vec![Vec::new(); g * g];
+        let spans = |cuts: &[f64], lo: f64, hi: f64| (0..g).filter(|&c| lo < cuts[c + 1] && hi > cuts[c]).collect();
+        for p in pieces {
+            let (cols, rows): (Vec<usize>, Vec<usize>) =
+                (spans(&self.xs, p.bounds.0.x, p.bounds.1.x), spans(&self.ys, p.bounds.0.y, p.bounds.1.y));
+            if cols.len() == 1 && rows.len() == 1 {
+                out[cols[0] * g + rows[0]].push(p);
+                continue;
+            }
+            for &c in &cols {
+                for &r in &rows {
+                    let rect = (DVec2::new(self.xs[c], self.ys[r]), DVec2::new(self.xs[c + 1], self.ys[r + 1]));
+                    out[c * g + r].extend(Piece::new(p.source, cut_to(&p.region, rect), p.near));
+                }
+            }
+        }
+        out
+    }
+}
+
+/// `region` cut to the rectangle `(lo, hi)`, ring by ring (Sutherland-Hodgman; the even-odd
+/// rule keeps holes holes).
+fn cut_to(region: &Region, (lo, hi): (DVec2, DVec2)) -> Region {
+    let mut rings = Vec::new();
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for ring in &region.rings {
+        clip_polygon(ring, |p: DVec2| p.x - lo.x, &mut a);
+        clip_polygon(&a, |p: DVec2| hi.x - p.x, &mut b);
+        clip_polygon(&b, |p: DVec2| p.y - lo.y, &mut a);
+        clip_polygon(&a, |p: DVec2| hi.y - p.y, &mut b);
+        if b.len() >= 3 {
+            rings.push(b.clone());
+        }
+    }
+    Region { rings }
+}
+
+/// Step 1(b) on one list of pieces: the lit part of every caster and of every other polygon.
+fn lit_pieces(
+    scene: &Scene,
+    casters: Vec<Piece>,
+    others: Vec<Piece>,
+    stats: &mut Pass1,
+) -> std::result::Result<Vec<Piece>, ClipError> {
     let seen = visible(casters.clone(), 0, stats)?;
     // The pieces of a face split into a fan never shadow each other: their lit parts come
     // from a sort without their sibling pieces.
@@ -407,14 +525,7 @@ fn lit_in_view(
         let lit = unshadowed(o.clone(), &seen, stats)?;
         pieces.extend(Piece::new(o.source, lit, o.near));
     }
-    Ok(pieces
-        .into_iter()
-        .map(|p| {
-            let plane = scene.polygons[p.source as usize].plane;
-            let rings = p.region.rings.iter().map(|r| r.iter().map(|&q| view.unmap(q, &plane)).collect()).collect();
-            DetailPolygon { source: p.source, rings }
-        })
-        .collect())
+    Ok(pieces)
 }
 
 impl ShadowDatabase {
@@ -448,15 +559,13 @@ impl ShadowDatabase {
         let mut stats = Pass1::default();
         for (s, lit, st) in done {
             samples[s].extend(lit);
-            stats.fragments += st.fragments;
-            stats.clips += st.clips;
-            stats.splits += st.splits;
-            stats.depth_max = stats.depth_max.max(st.depth_max);
+            stats.add(&st);
         }
         counters.add("light_space_fragments", stats.fragments);
         counters.add("clip_operations", stats.clips);
         counters.add("interpenetration_splits", stats.splits);
         counters.add("area_sort_depth_max", stats.depth_max);
+        counters.add("light_view_tiles", stats.tiles);
         let detail: usize = samples.iter().map(Vec::len).sum();
         let verts: usize = samples.iter().flatten().flat_map(|d| &d.rings).map(Vec::len).sum();
         counters.add("detail_polygons", detail as u64);

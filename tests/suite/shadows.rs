@@ -110,6 +110,21 @@ fn solid_cull_is_exercised_on_closed_meshes() {
     }
 }
 
+/// Atherton-Weiler-Greenberg's light view is cut into regions sorted apart on the generated
+/// spheres that `generated_scenes` checks against ray-cast (so the cut is tested there), and
+/// the database has the same lit area as one sorted whole would: every pixel's light agrees
+/// with Bouknight-Kelley's.
+#[test]
+fn light_view_regions_are_exercised() {
+    let scene = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
+    let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg, ..Default::default() };
+    let awg = umbra::render(&scene, &opts).unwrap();
+    let tiles = awg.stats.shadow_counters.get("light_view_tiles");
+    assert!(tiles > 4, "{tiles} regions");
+    let bk = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::BouknightKelley(Default::default()));
+    assert_light_agree(&scene, &bk, &awg.frame, "regions against bouknight-kelley");
+}
+
 /// A square parallel to the floor under a point light casts exactly its central projection:
 /// every floor pixel is in shadow exactly when its point lies inside the projected square.
 #[test]
