@@ -1,7 +1,7 @@
 //! Closed solids: the parts of an object whose polygons close up into a watertight,
 //! consistently wound surface. Found once, when a scene compiles, so that shadow stages can
 //! drop the polygons of a solid that face away from a light (see
-//! `docs/bouknight-kelley.md`, "Speed").
+//! `docs/algorithms/bouknight-kelley.md`, "Speed-ups that are ours").
 //!
 //! A *solid* is a connected set of an object's polygons in which every edge (between welded
 //! vertex positions) is used by exactly two polygons, once in each direction. Its *sign* is

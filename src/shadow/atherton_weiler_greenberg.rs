@@ -404,8 +404,10 @@ fn lit_in_view(
         lit_pieces(scene, casters, others, stats)?
     } else {
         // Independent regions of the view, sorted in parallel.
-        let tiles = Tiles::over(&casters, &others);
-        let lists: Vec<(Vec<Piece>, Vec<Piece>)> = tiles.split(casters).into_iter().zip(tiles.split(others)).collect();
+        let all = casters.iter().chain(&others).map(|p| p.bounds);
+        let rect = all.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+        let mut lists = Vec::new();
+        regions(casters, others, rect, 0, &mut lists);
         stats.tiles += lists.len() as u64;
         let done: Vec<(Vec<Piece>, Pass1)> = lists
             .into_par_iter()
@@ -431,53 +433,56 @@ fn lit_in_view(
         .collect())
 }
 
-/// Pieces per region of a light view, on average, when the view is cut into regions.
+/// Most casters a region of a light view keeps before it is cut in four.
 const TILE_PIECES: usize = 128;
 
-/// A grid of rectangles over a light view (ours, not the paper's): each rectangle's pieces,
-/// cut to it, are sorted on their own, since what hides what inside one rectangle depends
-/// only on what lies in it. A large polygon behind many small ones (a floor under a crowd)
-/// is then clipped only by those over each rectangle, not by all of them in turn, and the
-/// rectangles are sorted in parallel.
-struct Tiles {
-    xs: Vec<f64>,
-    ys: Vec<f64>,
+/// Regions of a light view (ours, not the paper's), found by cutting the view in four until
+/// each region holds at most [`TILE_PIECES`] casters: each region's pieces, cut to it, are
+/// sorted on their own, since what hides what inside one region depends only on what lies in
+/// it. A large polygon behind many small ones (a floor under a crowd) is then clipped only by
+/// those over each region, not by all of them in turn, and the regions are sorted in
+/// parallel.
+fn regions(
+    casters: Vec<Piece>,
+    others: Vec<Piece>,
+    rect: (DVec2, DVec2),
+    depth: u32,
+    out: &mut Vec<(Vec<Piece>, Vec<Piece>)>,
+) {
+    if casters.len() <= TILE_PIECES || depth >= 16 {
+        out.push((casters, others));
+        return;
+    }
+    let (lo, hi) = rect;
+    let mid = (lo + hi) * 0.5;
+    let quarters = [
+        (lo, mid),
+        (DVec2::new(mid.x, lo.y), DVec2::new(hi.x, mid.y)),
+        (DVec2::new(lo.x, mid.y), DVec2::new(mid.x, hi.y)),
+        (mid, hi),
+    ];
+    let (cs, os) = (into_quarters(casters, &quarters), into_quarters(others, &quarters));
+    for ((c, o), q) in cs.into_iter().zip(os).zip(quarters) {
+        regions(c, o, q, depth + 1, out);
+    }
 }
 
-impl Tiles {
-    fn over(casters: &[Piece], others: &[Piece]) -> Tiles {
-        let all = casters.iter().chain(others);
-        let (lo, hi) =
-            all.map(|p| p.bounds).fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
-        let g = (((casters.len() + others.len()) as f64 / TILE_PIECES as f64).sqrt().ceil() as usize).clamp(1, 64);
-        let cuts = |lo: f64, hi: f64| {
-            (0..=g).map(|k| if k == g { hi } else { lo + (hi - lo) * k as f64 / g as f64 }).collect()
-        };
-        Tiles { xs: cuts(lo.x, hi.x), ys: cuts(lo.y, hi.y) }
-    }
-
-    /// The tiles (column-major) whose rectangles `pieces` overlap, with each piece cut to
-    /// each rectangle it crosses (a piece inside one rectangle is kept whole).
-    fn split(&self, pieces: Vec<Piece>) -> Vec<Vec<Piece>> {
-        let g = self.xs.len() - 1;
-        let mut out = vec![Vec::new(); g * g];
-        let spans = |cuts: &[f64], lo: f64, hi: f64| (0..g).filter(|&c| lo < cuts[c + 1] && hi > cuts[c]).collect();
-        for p in pieces {
-            let (cols, rows): (Vec<usize>, Vec<usize>) =
-                (spans(&self.xs, p.bounds.0.x, p.bounds.1.x), spans(&self.ys, p.bounds.0.y, p.bounds.1.y));
-            if cols.len() == 1 && rows.len() == 1 {
-                out[cols[0] * g + rows[0]].push(p);
-                continue;
-            }
-            for &c in &cols {
-                for &r in &rows {
-                    let rect = (DVec2::new(self.xs[c], self.ys[r]), DVec2::new(self.xs[c + 1], self.ys[r + 1]));
-                    out[c * g + r].extend(Piece::new(p.source, cut_to(&p.region, rect), p.near));
-                }
-            }
+/// Each piece into the quarters its box overlaps, cut to each when it crosses a border.
+fn into_quarters(pieces: Vec<Piece>, quarters: &[(DVec2, DVec2); 4]) -> [Vec<Piece>; 4] {
+    let mut out: [Vec<Piece>; 4] = Default::default();
+    let touches =
+        |b: (DVec2, DVec2), q: (DVec2, DVec2)| b.0.x < q.1.x && b.1.x > q.0.x && b.0.y < q.1.y && b.1.y > q.0.y;
+    for p in pieces {
+        let hit: smallvec::SmallVec<[usize; 4]> = (0..4).filter(|&k| touches(p.bounds, quarters[k])).collect();
+        if let [k] = hit[..] {
+            out[k].push(p);
+            continue;
         }
-        out
+        for k in hit {
+            out[k].extend(Piece::new(p.source, cut_to(&p.region, quarters[k]), p.near));
+        }
     }
+    out
 }
 
 /// `region` cut to the rectangle `(lo, hi)`, ring by ring (Sutherland-Hodgman; the even-odd

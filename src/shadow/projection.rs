@@ -30,7 +30,7 @@ pub fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> boo
 /// sample lies outside the solid's bounds (a directional light always does). Such a polygon
 /// never needs to cast: a shadow ray that crosses it has crossed, nearer the light, a polygon
 /// of the same solid that faces the light (ours, not the papers'; see
-/// `docs/bouknight-kelley.md`, "Speed").
+/// `docs/algorithms/bouknight-kelley.md`, "Speed-ups that are ours").
 pub fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample) -> bool {
     let Some(solid) = scene.solids.get(scene.solid_of[i] as usize) else { return false };
     let outside = match sample {
