@@ -400,29 +400,25 @@ fn lit_in_view(
             others.push(piece);
         }
     }
-    let pieces = if casters.len() + others.len() < 2 * TILE_PIECES {
-        lit_pieces(scene, casters, others, stats)?
-    } else {
-        // Independent regions of the view, sorted in parallel.
-        let all = casters.iter().chain(&others).map(|p| p.bounds);
-        let rect = all.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
-        let mut lists = Vec::new();
-        regions(casters, others, rect, 0, &mut lists);
-        stats.tiles += lists.len() as u64;
-        let done: Vec<(Vec<Piece>, Pass1)> = lists
-            .into_par_iter()
-            .map(|(casters, others)| {
-                let mut st = Pass1::default();
-                Ok((lit_pieces(scene, casters, others, &mut st)?, st))
-            })
-            .collect::<std::result::Result<_, ClipError>>()?;
-        let mut pieces = Vec::new();
-        for (lit, st) in done {
-            pieces.extend(lit);
-            stats.add(&st);
-        }
-        pieces
-    };
+    // Independent regions of the view (one, for up to TILE_PIECES casters), sorted in
+    // parallel.
+    let all = casters.iter().chain(&others).map(|p| p.bounds);
+    let rect = all.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+    let mut lists = Vec::new();
+    regions(casters, others, rect, 0, &mut lists);
+    stats.tiles += lists.len() as u64;
+    let done: Vec<(Vec<Piece>, Pass1)> = lists
+        .into_par_iter()
+        .map(|(casters, others)| {
+            let mut st = Pass1::default();
+            Ok((lit_pieces(scene, casters, others, &mut st)?, st))
+        })
+        .collect::<std::result::Result<_, ClipError>>()?;
+    let mut pieces = Vec::new();
+    for (lit, st) in done {
+        pieces.extend(lit);
+        stats.add(&st);
+    }
     Ok(pieces
         .into_iter()
         .map(|p| {

@@ -94,11 +94,11 @@ fn shadow_polygons(
         .filter(|&i| ctx.visible[i as usize] && sample.on_seen_side(&scene.polygons[i as usize].plane, ctx.view.eye))
         .collect();
     let casting = |i: usize| scene.casts_shadows(i) && !edge_on(scene, i, sample, ctx.extent);
-    let culled = |i: usize| options.solid_cull && faces_away_on_solid(scene, i, sample);
-    let casters: Vec<u32> = (0..n as u32).filter(|&i| casting(i as usize) && !culled(i as usize)).collect();
+    let (casters, dropped): (Vec<u32>, Vec<u32>) = (0..n as u32)
+        .filter(|&i| casting(i as usize))
+        .partition(|&i| !(options.solid_cull && faces_away_on_solid(scene, i as usize, sample)));
     if options.solid_cull {
-        let dropped = (0..n).filter(|&i| casting(i) && culled(i)).count();
-        counters.add("casters_dropped_facing_away", dropped as u64);
+        counters.add("casters_dropped_facing_away", dropped.len() as u64);
     }
     counters.add("receivers", receivers.len() as u64);
     counters.add("casters", casters.len() as u64);
