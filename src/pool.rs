@@ -42,6 +42,18 @@ impl<B> Kept<B> {
     }
 }
 
+impl<B: Default> Kept<B> {
+    /// A kept item, or a new one when none is kept.
+    pub(crate) fn take_any(&self) -> B {
+        self.0.lock().ok().and_then(|mut kept| kept.pop()).unwrap_or_default()
+    }
+
+    /// Keeps `item` for a later frame.
+    pub(crate) fn put(&self, item: B) {
+        self.keep(item);
+    }
+}
+
 /// Buffers of `T` kept for reuse.
 pub(crate) type Pool<T> = Kept<Vec<T>>;
 
@@ -116,6 +128,10 @@ pub(crate) struct Pools {
     pub(crate) points: Pool<glam::DVec3>,
     /// Whole frames (what each mirror shows).
     pub(crate) frames: Frames,
+    /// The view's screen polygons.
+    pub(crate) screens: Kept<crate::view::Screen>,
+    /// Watkins' per-band edge tables and span sets.
+    pub(crate) scan_bands: Kept<crate::visibility::BandScratch>,
 }
 
 impl Pools {
@@ -128,6 +144,8 @@ impl Pools {
             + self.masks.bytes()
             + self.points.bytes()
             + self.frames.bytes()
+            + self.screens.sum(crate::view::Screen::bytes)
+            + self.scan_bands.sum(crate::visibility::BandScratch::bytes)
     }
 }
 

@@ -6,7 +6,8 @@
 //! polygon that reaches it.
 
 use crate::scan::{for_each_span, EdgeTable};
-use crate::view::ScreenPolygon;
+use crate::view::{Screen, ScreenPolygon};
+use glam::DVec2;
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -70,7 +71,7 @@ pub struct DepthBuffer<D> {
 /// (any contents; reallocated if too small), so that a caller drawing many frames can hand
 /// back the last frame's buffers instead of having fresh pages zeroed by the system each time.
 pub fn rasterize<D: Depth>(
-    screen: &[ScreenPolygon],
+    screen: &Screen,
     width: u32,
     height: u32,
     ids: Option<Vec<u32>>,
@@ -91,7 +92,7 @@ pub fn rasterize<D: Depth>(
     depth.resize(w * h as usize, D::ZERO);
     let band = crate::scan::band_height(h);
     let chunk = w * band as usize;
-    let members = band_members(screen, h, band);
+    let members = screen.band_members(h, band);
     let mut id_chunks: Vec<&mut [u32]> = ids.chunks_mut(chunk).collect();
     id_chunks.resize_with(depth.len().div_ceil(chunk), || &mut []);
     let counts: Vec<(u64, u64)> = depth
@@ -101,24 +102,10 @@ pub fn rasterize<D: Depth>(
         .map(|(bi, (depth, ids))| {
             let y0 = bi as u32 * band;
             let rows = BandRows { y0, lines: y0..(y0 + band).min(h), width, height: h, depth, ids };
-            draw_band(members[bi].iter().map(|&i| &screen[i]), rows)
+            draw_band(members[bi].iter().map(|&i| &screen[i as usize]).map(|p| (p, screen.ring(p))), rows)
         })
         .collect();
     DepthBuffer { ids, depth, tests: counts.iter().map(|c| c.0).sum(), writes: counts.iter().map(|c| c.1).sum() }
-}
-
-/// The polygons each band of `band` lines meets, in drawing order.
-fn band_members(screen: &[ScreenPolygon], h: u32, band: u32) -> Vec<Vec<usize>> {
-    let mut members = vec![Vec::new(); h.div_ceil(band) as usize];
-    for (i, p) in screen.iter().enumerate() {
-        let (lo, hi) = p.ring.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(q.y), hi.max(q.y)));
-        let first = (lo - 0.5).ceil().clamp(0.0, h as f64) as u32;
-        let end = (hi - 0.5).ceil().clamp(0.0, h as f64) as u32;
-        for b in first / band..end.div_ceil(band) {
-            members[b as usize].push(i);
-        }
-    }
-    members
 }
 
 /// One band's rows of the depth and id buffers (`ids` empty for depth only).
@@ -133,15 +120,18 @@ struct BandRows<'a, D> {
 
 /// The z-buffer loop over one band: clears its rows, then draws `polygons` into them in
 /// order, span by span. Returns the pixels tested and written.
-fn draw_band<'p, D: Depth>(polygons: impl Iterator<Item = &'p ScreenPolygon>, rows: BandRows<D>) -> (u64, u64) {
+fn draw_band<'p, D: Depth>(
+    polygons: impl Iterator<Item = (&'p ScreenPolygon, &'p [DVec2])>,
+    rows: BandRows<D>,
+) -> (u64, u64) {
     let BandRows { y0, lines, width, height, depth, ids } = rows;
     let w = width as usize;
     depth.fill(D::FAR);
     ids.fill(u32::MAX);
     let mut table = EdgeTable::new(height);
     let (mut tests, mut writes) = (0u64, 0u64);
-    for p in polygons {
-        for_each_span(&mut table, &[&p.ring], width, height, lines.clone(), |y, x0, x1| {
+    for (p, ring) in polygons {
+        for_each_span(&mut table, &[ring], width, height, lines.clone(), |y, x0, x1| {
             let z0 = D::from_f64(p.depth.inv_z(x0 as f64 + 0.5, y as f64 + 0.5));
             let a = D::from_f64(p.depth.a);
             let (start, end) = ((y - y0) as usize * w + x0 as usize, (y - y0) as usize * w + x1 as usize);

@@ -13,7 +13,7 @@ use crate::scene::Scene;
 use crate::shading::{RunShading, Shader};
 use crate::shadow::{ShadowContext, ShadowDatabase, ShadowMethod};
 use crate::stats::{Counters, Stats};
-use crate::view::View;
+use crate::view::{Screen, View};
 use crate::visibility::{FrameRuns, VisibilityMethod};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -72,11 +72,11 @@ struct Band<'f> {
 }
 
 /// How many screen polygons cover each pixel centre.
-fn depth_complexity(screen: &[crate::view::ScreenPolygon], w: u32, h: u32) -> Vec<u32> {
+fn depth_complexity(screen: &Screen, w: u32, h: u32) -> Vec<u32> {
     let mut count = vec![0u32; (w * h) as usize];
     let mut table = crate::scan::EdgeTable::new(h);
-    for p in screen {
-        crate::scan::for_each_span(&mut table, &[&p.ring], w, h, 0..h, |y, x0, x1| {
+    for (_, ring) in screen.iter() {
+        crate::scan::for_each_span(&mut table, &[ring], w, h, 0..h, |y, x0, x1| {
             for c in &mut count[(y * w + x0) as usize..(y * w + x1) as usize] {
                 *c += 1;
             }
@@ -253,7 +253,7 @@ fn frame_pass(
 
     let t = Instant::now();
     bar.phase("view: clipping and projecting");
-    let screen = view.screen_polygons(scene);
+    let screen = view.screen_polygons_in(scene, pools.screens.take_any());
     stats.visibility_counters.add("screen_polygons", screen.len() as u64);
     stats.time_ms.insert("view", ms(t.elapsed()));
 
@@ -302,6 +302,7 @@ fn frame_pass(
     let outlines = shadows.outlines();
     drop(shadows);
     drop(ctx);
+    pools.screens.put(screen);
     Ok((Rendered { frame, stats }, runs, outlines))
 }
 
@@ -311,7 +312,7 @@ fn visible_runs(
     scene: &Scene,
     opts: &RenderOptions,
     view: &View,
-    screen: &[crate::view::ScreenPolygon],
+    screen: &Screen,
     pools: &crate::pool::Pools,
     counters: &mut Counters,
 ) -> (FrameRuns, Option<PixelCounters>) {

@@ -124,6 +124,8 @@ pub struct EdgeTable {
     long: Vec<u32>,
     /// The sorted edges' last buffer, kept for the next frame's sort.
     spare: Vec<Edge>,
+    /// The lines edges are cut to, if any ([`EdgeTable::clear_to`]).
+    within: Option<Range<u32>>,
 }
 
 /// An edge spanning at most this many lines that starts this far above a band has ended
@@ -144,6 +146,15 @@ impl EdgeTable {
         self.height = height;
         self.lines = 0..0;
         self.built = false;
+        self.within = None;
+    }
+
+    /// Empties the table, keeping its memory, for the lines `lines` of an image `height`
+    /// lines high: edges added from now on are cut to those lines (the part of each edge on
+    /// them, with the same line equation, so the same crossings).
+    pub fn clear_to(&mut self, height: u32, lines: Range<u32>) {
+        self.clear(height);
+        self.within = Some(lines);
     }
 
     /// Adds the edges of a closed ring of polygon `tag`. Rings of one tag combine by the
@@ -159,7 +170,13 @@ impl EdgeTable {
     }
 
     fn add_edge(&mut self, tag: u32, a: DVec2, b: DVec2) {
-        if let Some(e) = Edge::new(tag, a, b, self.height) {
+        if let Some(mut e) = Edge::new(tag, a, b, self.height) {
+            if let Some(lines) = &self.within {
+                (e.first, e.end) = (e.first.max(lines.start), e.end.min(lines.end));
+                if e.first >= e.end {
+                    return;
+                }
+            }
             self.edges.push(e);
         }
     }
@@ -503,6 +520,13 @@ impl OpenSet {
     /// An empty dense set for tags `0..tags`.
     pub(crate) fn new(tags: usize) -> OpenSet {
         OpenSet { slot: vec![CLOSED; tags], tags: Vec::new(), starts: Vec::new() }
+    }
+
+    /// Empties the set and makes it dense for tags `0..tags`, keeping its memory.
+    pub(crate) fn reset(&mut self, tags: usize) {
+        self.clear();
+        // Every slot is closed after `clear`: only new ones need setting.
+        self.slot.resize(tags, CLOSED);
     }
 
     /// An empty sparse set, for any tags.

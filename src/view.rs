@@ -7,8 +7,10 @@
 //! the world plane, so depth at a pixel centre is the exact ray-plane hit of section 3.
 
 use crate::geometry::{clip_in_place, Plane};
+use crate::scan::boundary;
 use crate::scene::{Camera, Scene};
 use glam::{DVec2, DVec3, DVec4};
+use rayon::prelude::*;
 
 /// Camera basis and projection.
 #[derive(Debug, Clone, Copy)]
@@ -54,15 +56,117 @@ impl DepthPlane {
     }
 }
 
-/// A polygon in screen space, ready to scan-convert.
-#[derive(Debug, Clone)]
+/// A polygon in screen space, ready to scan-convert; its ring is kept in its [`Screen`].
+#[derive(Debug, Clone, Copy)]
 pub(crate) struct ScreenPolygon {
     /// Index of the scene polygon it came from.
     pub poly: u32,
-    /// Its vertices in screen space (one ring; near/far clipping keeps a single ring).
-    pub ring: Vec<DVec2>,
+    /// Its vertices in screen space (one ring; near/far clipping keeps a single ring):
+    /// `Screen::points[start..start + len]`.
+    len: u32,
+    start: usize,
     /// Its inverse depth over the screen.
     pub depth: DepthPlane,
+}
+
+/// The screen polygons of a view, their rings stored one after another in one buffer (a
+/// million triangles are a million rings: one allocation each would cost more than
+/// clipping them).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Screen {
+    polygons: Vec<ScreenPolygon>,
+    points: Vec<DVec2>,
+}
+
+impl Screen {
+    /// Adds scene polygon `poly` with its screen `ring` and inverse depth.
+    pub fn push(&mut self, poly: u32, ring: &[DVec2], depth: DepthPlane) {
+        let start = self.points.len();
+        self.points.extend_from_slice(ring);
+        self.polygons.push(ScreenPolygon { poly, len: ring.len() as u32, start, depth });
+    }
+
+    /// The ring of polygon `p` (one of this screen's).
+    #[inline]
+    pub fn ring(&self, p: &ScreenPolygon) -> &[DVec2] {
+        &self.points[p.start..p.start + p.len as usize]
+    }
+
+    /// Every polygon with its ring.
+    pub fn iter(&self) -> impl Iterator<Item = (&ScreenPolygon, &[DVec2])> {
+        self.polygons.iter().map(|p| (p, self.ring(p)))
+    }
+
+    /// Number of polygons.
+    pub fn len(&self) -> usize {
+        self.polygons.len()
+    }
+
+    /// Empties it, keeping its memory.
+    fn clear(&mut self) {
+        self.polygons.clear();
+        self.points.clear();
+    }
+
+    /// Appends `other`'s polygons after this one's.
+    fn append(&mut self, other: &Screen) {
+        let shift = self.points.len();
+        self.points.extend_from_slice(&other.points);
+        self.polygons.extend(other.polygons.iter().map(|p| ScreenPolygon { start: p.start + shift, ..*p }));
+    }
+
+    /// For each band of `band` lines of an image `height` lines high, the polygons (indices,
+    /// increasing) that reach one of its lines' centres; polygons that reach none are in no
+    /// band. Found in parallel, in chunks of polygons.
+    pub fn band_members(&self, height: u32, band: u32) -> Vec<Vec<u32>> {
+        const CHUNK: usize = 1 << 14;
+        let bands = height.div_ceil(band) as usize;
+        let parts: Vec<Vec<Vec<u32>>> = self
+            .polygons
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(c, chunk)| {
+                let mut lists = vec![Vec::new(); bands];
+                for (i, p) in (c * CHUNK..).zip(chunk) {
+                    let (lo, hi) = self
+                        .ring(p)
+                        .iter()
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(q.y), hi.max(q.y)));
+                    let (first, end) = (boundary(lo, height), boundary(hi, height));
+                    if first >= end {
+                        continue;
+                    }
+                    for list in &mut lists[(first / band) as usize..end.div_ceil(band) as usize] {
+                        list.push(i as u32);
+                    }
+                }
+                lists
+            })
+            .collect();
+        (0..bands)
+            .into_par_iter()
+            .map(|b| {
+                let mut list = Vec::with_capacity(parts.iter().map(|p| p[b].len()).sum());
+                for part in &parts {
+                    list.extend_from_slice(&part[b]);
+                }
+                list
+            })
+            .collect()
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.polygons.capacity() * std::mem::size_of::<ScreenPolygon>()
+            + self.points.capacity() * std::mem::size_of::<DVec2>()
+    }
+}
+
+impl std::ops::Index<usize> for Screen {
+    type Output = ScreenPolygon;
+    fn index(&self, i: usize) -> &ScreenPolygon {
+        &self.polygons[i]
+    }
 }
 
 impl View {
@@ -207,18 +311,25 @@ impl View {
         let [a, b] = scratch;
         a.clear();
         a.extend(verts.iter().map(|&p| self.to_camera(p)));
-        clip_in_place(a, b, |c| c.z - self.near);
-        if let Some(far) = far {
-            clip_in_place(a, b, |c| far - c.z);
-        }
         // The guard band (10⁴ times the view's width): a polygon reaching beyond it is cut
         // there, far off screen, so that screen coordinates stay small enough for the scan
         // converter's arithmetic. Polygons within it (all but huge ones) are not touched.
         let g = 1e4 * (self.t * self.aspect).max(self.t);
-        let band: [&dyn Fn(DVec3) -> f64; 4] =
-            [&|c| g * c.z - c.x, &|c| g * c.z + c.x, &|c| g * c.z - c.y, &|c| g * c.z + c.y];
-        for plane in band {
-            clip_in_place(a, b, plane);
+        let near = |c: DVec3| c.z - self.near;
+        let far = far.map(|far| move |c: DVec3| far - c.z);
+        let band: [fn(f64, DVec3) -> f64; 4] =
+            [|g, c| g * c.z - c.x, |g, c| g * c.z + c.x, |g, c| g * c.z - c.y, |g, c| g * c.z + c.y];
+        // Most polygons are inside every plane: one pass finds that, and no plane cuts them.
+        let cut =
+            |c: DVec3| near(c) < 0.0 || far.is_some_and(|f| f(c) < 0.0) || band.iter().any(|plane| plane(g, c) < 0.0);
+        if a.iter().any(|&c| cut(c)) {
+            clip_in_place(a, b, near);
+            if let Some(far) = far {
+                clip_in_place(a, b, far);
+            }
+            for plane in band {
+                clip_in_place(a, b, |c| plane(g, c));
+            }
         }
         if a.len() < 3 {
             return false;
@@ -232,19 +343,38 @@ impl View {
     }
 
     /// Every polygon of the scene that survives clipping, in screen space.
-    pub(crate) fn screen_polygons(&self, scene: &Scene) -> Vec<ScreenPolygon> {
-        let mut scratch = [Vec::new(), Vec::new()];
-        let mut ring = Vec::new();
-        let mut out = Vec::with_capacity(scene.polygons.len());
-        for (i, p) in scene.polygons.iter().enumerate() {
-            let Some(depth) = self.depth_plane(&p.plane) else {
-                continue;
-            };
-            if self.clip_project(scene.verts(i), &mut scratch, &mut ring) {
-                out.push(ScreenPolygon { poly: i as u32, ring: ring.clone(), depth });
-            }
+    pub(crate) fn screen_polygons(&self, scene: &Scene) -> Screen {
+        self.screen_polygons_in(scene, Screen::default())
+    }
+
+    /// [`View::screen_polygons`] into the memory of `kept` (a screen of an earlier frame):
+    /// clipped and projected in parallel, in chunks of polygons, then joined in order.
+    pub(crate) fn screen_polygons_in(&self, scene: &Scene, mut kept: Screen) -> Screen {
+        const CHUNK: usize = 1 << 12;
+        let parts: Vec<Screen> = scene
+            .polygons
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(c, chunk)| {
+                let (mut scratch, mut ring, mut part) = ([Vec::new(), Vec::new()], Vec::new(), Screen::default());
+                for (i, p) in (c * CHUNK..).zip(chunk) {
+                    let Some(depth) = self.depth_plane(&p.plane) else {
+                        continue;
+                    };
+                    if self.clip_project(scene.verts(i), &mut scratch, &mut ring) {
+                        part.push(i as u32, &ring, depth);
+                    }
+                }
+                part
+            })
+            .collect();
+        kept.clear();
+        kept.polygons.reserve(parts.iter().map(Screen::len).sum());
+        kept.points.reserve(parts.iter().map(|p| p.points.len()).sum());
+        for part in &parts {
+            kept.append(part);
         }
-        out
+        kept
     }
 }
 

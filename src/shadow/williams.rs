@@ -31,7 +31,7 @@ use crate::pool::Pool;
 use crate::raster::rasterize;
 use crate::scene::{Camera, LightSample};
 use crate::stats::Counters;
-use crate::view::{DepthPlane, ScreenPolygon, View};
+use crate::view::{DepthPlane, Screen, View};
 use crate::visibility::Run;
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
@@ -251,33 +251,30 @@ impl DepthMap {
             let plane = &scene.polygons[i].plane;
             scene.casts_shadows(i) && !(o.cull_front && sample.side_of(plane) > 0.0)
         });
-        let screen: Vec<ScreenPolygon> = match &proj {
+        let mut screen = Screen::default();
+        match &proj {
             Projection::Perspective(view) => {
                 let mut scratch = [Vec::new(), Vec::new()];
                 let mut ring = Vec::new();
-                casters
-                    .filter_map(|i| {
-                        let depth = view.depth_plane(&scene.polygons[i].plane)?;
-                        view.clip_project(scene.verts(i), &mut scratch, &mut ring).then(|| ScreenPolygon {
-                            poly: i as u32,
-                            ring: ring.clone(),
-                            depth,
-                        })
-                    })
-                    .collect()
+                for i in casters {
+                    let Some(depth) = view.depth_plane(&scene.polygons[i].plane) else { continue };
+                    if view.clip_project(scene.verts(i), &mut scratch, &mut ring) {
+                        screen.push(i as u32, &ring, depth);
+                    }
+                }
             }
-            Projection::Ortho { u, v, u0, v0, texel, .. } => casters
-                .filter_map(|i| {
-                    let depth = proj.depth_plane(&scene.polygons[i].plane)?;
-                    let ring = scene
-                        .verts(i)
-                        .iter()
-                        .map(|&p| DVec2::new((p.dot(*u) - u0) / texel, (v0 - p.dot(*v)) / texel))
-                        .collect();
-                    Some(ScreenPolygon { poly: i as u32, ring, depth })
-                })
-                .collect(),
-        };
+            Projection::Ortho { u, v, u0, v0, texel, .. } => {
+                let mut ring = Vec::new();
+                for i in casters {
+                    let Some(depth) = proj.depth_plane(&scene.polygons[i].plane) else { continue };
+                    ring.clear();
+                    ring.extend(
+                        scene.verts(i).iter().map(|&p| DVec2::new((p.dot(*u) - u0) / texel, (v0 - p.dot(*v)) / texel)),
+                    );
+                    screen.push(i as u32, &ring, depth);
+                }
+            }
+        }
         let storage = ctx.pools.f32.clone();
         let nearness = rasterize::<f32>(&screen, size + PAD, size, None, storage.take()).depth;
         DepthMap { rows: proj.rows(), proj, size, nearness, storage }

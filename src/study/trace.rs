@@ -8,7 +8,7 @@ use crate::scan::ActiveEdges;
 use crate::scene::Scene;
 use crate::shadow::{Decision, Picture, ShadowContext, ShadowMethod, ShadowStage, ShadowWalker};
 use crate::stats::Counters;
-use crate::view::{ScreenPolygon, View};
+use crate::view::{Screen, View};
 use crate::visibility::{resolve, Run, ScanlineVisibility, SpanRecord, Visibility};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -113,7 +113,8 @@ pub fn trace_lines(
             }
         };
         let (mut entering, mut leaving) = (vec![Vec::new(); lines.len()], vec![Vec::new(); lines.len()]);
-        for e in vis.table().edges() {
+        let table = vis.whole_table();
+        for e in table.edges() {
             for (at, list) in [(e.1, &mut entering), (e.2, &mut leaving)] {
                 if lines.contains(&at) {
                     list[(at - lines.start) as usize].push(edge(e));
@@ -126,7 +127,7 @@ pub fn trace_lines(
         for y in 0..lines.start {
             walker.start_line(y);
         }
-        let mut aet = ActiveEdges::new(vis.table(), lines.clone());
+        let mut aet = ActiveEdges::new(&table, lines.clone());
         let rows = visible.into_iter().zip(entering).zip(leaving);
         for (line, (((runs, spans), entering), leaving)) in lines.clone().zip(rows) {
             walker.start_line(line);
@@ -151,11 +152,11 @@ fn with_stage<T>(
     scene: &Scene,
     view: &View,
     shadows: &ShadowMethod,
-    f: impl FnOnce(&[ScreenPolygon], &ScanlineVisibility, &ShadowContext, &dyn ShadowStage) -> Result<T>,
+    f: impl FnOnce(&Screen, &ScanlineVisibility, &ShadowContext, &dyn ShadowStage) -> Result<T>,
 ) -> Result<T> {
     let screen = view.screen_polygons(scene);
     let mut counters = Counters::default();
-    let vis = ScanlineVisibility::new(scene, &screen, view, &mut counters);
+    let vis = ScanlineVisibility::new(scene, &screen, view, &Default::default(), &mut counters);
     let frame_runs = resolve(&vis as &dyn Visibility, view.height, &mut counters);
     let ctx = ShadowContext::new(scene, view, &frame_runs, true);
     let stage = shadows.prepare(&ctx, &mut counters)?;

@@ -7,14 +7,14 @@ mod scanline;
 mod zbuffer;
 
 use ray_cast::RayCastVisibility;
-pub(crate) use scanline::ScanlineVisibility;
 pub use scanline::SpanRecord;
+pub(crate) use scanline::{BandScratch, ScanlineVisibility};
 use zbuffer::ZBufferVisibility;
 
 use crate::pool::Pools;
 use crate::scene::Scene;
 use crate::stats::Counters;
-use crate::view::{ScreenPolygon, View};
+use crate::view::{Screen, View};
 use std::ops::Range;
 
 /// A run of pixels `x0..x1` on one scanline that all see scene polygon `poly`.
@@ -71,12 +71,12 @@ impl VisibilityMethod {
         self,
         scene: &'a Scene,
         view: &'a View,
-        screen: &'a [ScreenPolygon],
+        screen: &'a Screen,
         pools: &Pools,
         counters: &mut Counters,
     ) -> Box<dyn Visibility + 'a> {
         match self {
-            VisibilityMethod::Scanline => Box::new(ScanlineVisibility::new(scene, screen, view, counters)),
+            VisibilityMethod::Scanline => Box::new(ScanlineVisibility::new(scene, screen, view, pools, counters)),
             VisibilityMethod::ZBuffer => Box::new(ZBufferVisibility::new(screen, view, pools, counters)),
             VisibilityMethod::RayCast => Box::new(RayCastVisibility::new(scene, view)),
         }

@@ -1,7 +1,7 @@
 //! Watkins' scanline hidden-surface algorithm (G. S. Watkins, "A real-time visible surface
 //! algorithm", Utah, 1970; see also Sutherland, Sproull & Schumacker 1974, §"Watkins").
 //!
-//! One [`EdgeTable`] holds the edges of every screen polygon, bucketed by their first line.
+//! An [`EdgeTable`] holds the edges of the screen polygons, bucketed by their first line.
 //! Each line, the [`ActiveEdges`] give the crossings in x order; between two neighbouring
 //! crossings the set of polygons covering the line is constant (a *span*). For each span the
 //! nearest polygon is found at its two end samples. Inverse depth is linear in x along a
@@ -9,38 +9,75 @@
 //! winners' depths cross inside the span (interpenetration), and the span is split where they
 //! cross and each part is solved again — Watkins' subdivision.
 
+//!
+//! The frame is walked in bands of lines, in parallel. Each band builds its own edge table
+//! from the polygons that reach it, with their edges cut to its lines: a table a band's
+//! size, built by the thread that walks it, in memory kept from the last frame.
+
 use super::{push_run, Run, Visibility};
-use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
+use crate::pool::{Kept, Pools};
+use crate::scan::{band_height, boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::scene::Scene;
 use crate::stats::Counters;
-use crate::view::{ScreenPolygon, View};
+use crate::view::{DepthPlane, Screen, View};
 use std::ops::Range;
 
-/// The prepared scanline stage: the edge table of every screen polygon.
+/// The prepared scanline stage: which polygons reach each band of lines.
 pub struct ScanlineVisibility<'a> {
-    screen: &'a [ScreenPolygon],
-    faces: Vec<u32>,
-    table: EdgeTable,
+    scene: &'a Scene,
+    screen: &'a Screen,
+    /// `members[b]`: the screen polygons reaching band `b` (of `band` lines), increasing.
+    members: Vec<Vec<u32>>,
+    band: u32,
     width: u32,
+    height: u32,
+    scratch: Kept<BandScratch>,
+}
+
+/// One band's working memory, kept between frames: its edge table, and its polygons' depth
+/// planes and scene indices (the table's tags index these), and the set of open polygons.
+#[derive(Default)]
+pub struct BandScratch {
+    table: EdgeTable,
+    planes: Vec<DepthPlane>,
+    polys: Vec<u32>,
+    set: OpenSet,
+}
+
+impl BandScratch {
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.table.bytes() + self.set.bytes() + (self.planes.capacity() * 3 + self.polys.capacity()) * 8
+    }
 }
 
 impl<'a> ScanlineVisibility<'a> {
-    /// Builds the edge table of `screen`.
-    pub fn new(scene: &Scene, screen: &'a [ScreenPolygon], view: &View, counters: &mut Counters) -> Self {
-        let mut table = EdgeTable::new(view.height);
-        for (i, p) in screen.iter().enumerate() {
-            table.add_ring(i as u32, &p.ring);
+    /// Sorts the polygons of `screen` into the bands they reach; band tables are kept in
+    /// `pools`.
+    pub fn new(scene: &'a Scene, screen: &'a Screen, view: &View, pools: &Pools, counters: &mut Counters) -> Self {
+        let band = band_height(view.height);
+        let members = screen.band_members(view.height, band);
+        counters.add("band_members", members.iter().map(Vec::len).sum::<usize>() as u64);
+        ScanlineVisibility {
+            scene,
+            screen,
+            members,
+            band,
+            width: view.width,
+            height: view.height,
+            scratch: pools.scan_bands.clone(),
         }
-        table.finish();
-        counters.add("edges", table.len() as u64);
-        counters.add("table_bytes", table.bytes() as u64);
-        let faces = scene.polygons.iter().map(|p| p.face).collect();
-        ScanlineVisibility { screen, faces, table, width: view.width }
     }
 
-    /// The edge table the walk uses.
-    pub fn table(&self) -> &EdgeTable {
-        &self.table
+    /// The edge table of every screen polygon over the whole frame, tagged by screen index
+    /// (what `umbra trace` lists; the walk builds one per band instead).
+    pub fn whole_table(&self) -> EdgeTable {
+        let mut table = EdgeTable::new(self.height);
+        for (i, (_, ring)) in self.screen.iter().enumerate() {
+            table.add_ring(i as u32, ring);
+        }
+        table.finish();
+        table
     }
 
     /// Walks `lines` as [`Visibility::walk`] does, also handing on each line's spans as
@@ -49,13 +86,52 @@ impl<'a> ScanlineVisibility<'a> {
         self.walk_lines(lines, &mut Counters::default(), true, &mut |y, runs, spans| f(y, runs, spans));
     }
 
+    /// The screen polygons that reach `lines`, increasing: one band's list when `lines` lie
+    /// in one band, else the union of the bands' lists.
+    fn members_of(&self, lines: &Range<u32>) -> std::borrow::Cow<'_, [u32]> {
+        let (first, last) = (lines.start / self.band, lines.end.saturating_sub(1) / self.band);
+        let bands =
+            &self.members[(first as usize).min(self.members.len())..(last as usize + 1).min(self.members.len())];
+        match bands {
+            [one] => one.as_slice().into(),
+            _ => {
+                let mut all: Vec<u32> = bands.concat();
+                all.sort_unstable();
+                all.dedup();
+                all.into()
+            }
+        }
+    }
+
+    /// Builds the edge table of `lines` in `scratch`: the edges of the polygons reaching
+    /// them, cut to them, tagged by their place in the band's list.
+    fn build_band(&self, lines: &Range<u32>, scratch: &mut BandScratch) {
+        let members = self.members_of(lines);
+        let BandScratch { table, planes, polys, set } = scratch;
+        table.clear_to(self.height, lines.clone());
+        planes.clear();
+        polys.clear();
+        for (k, &i) in members.iter().enumerate() {
+            let p = &self.screen[i as usize];
+            table.add_ring(k as u32, self.screen.ring(p));
+            planes.push(p.depth);
+            polys.push(p.poly);
+        }
+        table.finish();
+        set.reset(members.len());
+    }
+
     fn walk_lines(&self, lines: Range<u32>, counters: &mut Counters, record: bool, f: &mut LineSink) {
-        let mut aet = ActiveEdges::new(&self.table, lines.clone());
-        let mut set = OpenSet::new(self.screen.len());
+        let mut scratch = self.scratch.take_any();
+        self.build_band(&lines, &mut scratch);
+        let BandScratch { table, planes, polys, set } = &mut scratch;
+        counters.add("edges", table.len() as u64);
+        let mut aet = ActiveEdges::new(table, lines.clone());
         let mut runs = Vec::new();
         let mut walk = Walk {
-            screen: self.screen,
-            faces: &self.faces,
+            scene: self.scene,
+            planes: planes.as_slice(),
+            polys: polys.as_slice(),
             yc: 0.0,
             spans: 0,
             splits: 0,
@@ -98,9 +174,11 @@ impl<'a> ScanlineVisibility<'a> {
         counters.add("span_splits", walk.splits);
         counters.add("depth_tests", walk.depth_tests);
         counters.add("active_edges_max", max_active as u64);
-        // Working memory of this band: active edges, the inside flags, the span set, the runs.
-        let band_bytes = aet.bytes() + set.bytes() + runs.capacity() * std::mem::size_of::<Run>();
+        // Working memory of this band: its table, active edges, the span set, the runs.
+        let band_bytes = table.bytes() + aet.bytes() + set.bytes() + runs.capacity() * std::mem::size_of::<Run>();
         counters.add("band_bytes_max", band_bytes as u64);
+        drop(aet);
+        self.scratch.put(scratch);
     }
 }
 
@@ -126,8 +204,10 @@ type LineSink<'f> = dyn FnMut(u32, &[Run], &[SpanRecord]) + 'f;
 
 /// Per-band scratch and counters.
 struct Walk<'s> {
-    screen: &'s [ScreenPolygon],
-    faces: &'s [u32],
+    scene: &'s Scene,
+    /// The band's polygons' depth planes and scene indices, by tag.
+    planes: &'s [DepthPlane],
+    polys: &'s [u32],
     yc: f64,
     spans: u64,
     splits: u64,
@@ -143,9 +223,9 @@ impl Walk<'_> {
         let xc = x as f64 + 0.5;
         self.depth_tests += set.len() as u64;
         let mut best = set[0];
-        let mut best_z = self.screen[best as usize].depth.inv_z(xc, self.yc);
+        let mut best_z = self.planes[best as usize].inv_z(xc, self.yc);
         for &i in &set[1..] {
-            let z = self.screen[i as usize].depth.inv_z(xc, self.yc);
+            let z = self.planes[i as usize].inv_z(xc, self.yc);
             if z > best_z || (z == best_z && i < best) {
                 best = i;
                 best_z = z;
@@ -161,7 +241,7 @@ impl Walk<'_> {
         let right = if b - a == 1 { left } else { self.nearest(set, b - 1) };
         let split = (left != right).then(|| {
             // The two winners' inverse depths are equal at x* (they interpenetrate there).
-            let (l, r) = (&self.screen[left as usize].depth, &self.screen[right as usize].depth);
+            let (l, r) = (&self.planes[left as usize], &self.planes[right as usize]);
             let x_star = ((r.b - l.b) * self.yc + (r.c - l.c)) / (l.a - r.a);
             let m = if x_star.is_finite() { boundary(x_star, u32::MAX) } else { a + (b - a) / 2 };
             m.clamp(a + 1, b - 1)
@@ -171,15 +251,15 @@ impl Walk<'_> {
             let covering = set
                 .iter()
                 .map(|&i| {
-                    let p = &self.screen[i as usize];
-                    (p.poly, self.faces[p.poly as usize], p.depth.inv_z(xa, yc), p.depth.inv_z(xb, yc))
+                    let (poly, depth) = (self.polys[i as usize], &self.planes[i as usize]);
+                    (poly, self.scene.polygons[poly as usize].face, depth.inv_z(xa, yc), depth.inv_z(xb, yc))
                 })
                 .collect();
-            let nearest = (self.screen[left as usize].poly, self.screen[right as usize].poly);
+            let nearest = (self.polys[left as usize], self.polys[right as usize]);
             record.push(SpanRecord { x0: a, x1: b, depth, covering, nearest, split_at: split });
         }
         match split {
-            None => push_run(runs, a, b, self.screen[left as usize].poly),
+            None => push_run(runs, a, b, self.polys[left as usize]),
             Some(m) => {
                 self.splits += 1;
                 self.resolve(set, a, m, depth + 1, runs);

@@ -7,7 +7,7 @@ use super::{runs_of_row, Run, Visibility};
 use crate::pool::Pools;
 use crate::raster::rasterize;
 use crate::stats::Counters;
-use crate::view::{ScreenPolygon, View};
+use crate::view::{Screen, View};
 use std::ops::Range;
 
 /// The prepared z-buffer stage: the filled polygon-index buffer (the depth buffer goes back
@@ -21,7 +21,7 @@ pub struct ZBufferVisibility {
 
 impl ZBufferVisibility {
     /// Rasterises every screen polygon into buffers taken from `pools`.
-    pub(crate) fn new(screen: &[ScreenPolygon], view: &View, pools: &Pools, counters: &mut Counters) -> Self {
+    pub(crate) fn new(screen: &Screen, view: &View, pools: &Pools, counters: &mut Counters) -> Self {
         let buffers = rasterize::<f64>(screen, view.width, view.height, Some(pools.u32.take()), pools.f64.take());
         counters.add("depth_tests", buffers.tests);
         counters.add("depth_writes", buffers.writes);
