@@ -145,6 +145,8 @@ fn mirrored_scene(scene: &Scene, plane: &Plane, m: DMat4, reflect_lights: bool) 
             ..*p
         });
     }
+    // Clipping by the mirror's plane opens solids, and the polygons are renumbered.
+    out.forget_solids();
     if reflect_lights {
         for l in &mut out.lights {
             l.kind = match l.kind {

@@ -754,6 +754,14 @@ impl Scene {
         &self.normals[p.start as usize..(p.start + p.len) as usize]
     }
 
+    /// Forgets the closed solids found at compile: for a scene whose polygons were changed
+    /// since (a mirror's scene: clipped, left out, renumbered), whose solids are not known.
+    pub(crate) fn forget_solids(&mut self) {
+        self.solids.clear();
+        self.solid_of.clear();
+        self.solid_of.resize(self.polygons.len(), solids::NO_SOLID);
+    }
+
     /// Whether polygon `i` casts shadows.
     #[inline]
     pub fn casts_shadows(&self, i: usize) -> bool {

@@ -113,3 +113,36 @@ fn a_mirror_seen_from_behind_reflects_nothing() {
     }
     assert!(reference_mirror_ids(&scene).iter().all(|&i| i == BACKGROUND));
 }
+
+/// A mirror's scene is the scene's polygons clipped, mirrored and renumbered, so the closed
+/// solids of the scene are not its solids: Bouknight-Kelley's solid cull must see none there.
+/// With the mirror listed first (every polygon after it renumbered), a closed block and, after
+/// it, a card turned away from the light, the cull still changes no pixel of the frame or of
+/// what the mirror shows.
+#[test]
+fn the_solid_cull_changes_nothing_in_a_mirror() {
+    use umbra::shadow::{BouknightKelleyOptions, ShadowMethod};
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/mirror.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mirror = "[[object]]\nname = \"mirror\"\nmaterial = \"mirror\"\npolygons = [ [[-2.5,0.3,-2.45],[1.5,0.3,-2.45],[1.5,2.8,-2.45],[-2.5,2.8,-2.45]] ]\n";
+    assert!(text.contains(mirror));
+    let bottom = "  [[-0.5,-0.5,-0.5],[0.5,-0.5,-0.5],[0.5,-0.5,0.5],[-0.5,-0.5,0.5]],\n]\nscale = [1.0, 1.6, 1.0]";
+    let text = text.replacen(mirror, "", 1).replacen("]\nscale = [1.0, 1.6, 1.0]", bottom, 1);
+    let text = text.replacen("[[object]]\nname = \"floor\"", &format!("{mirror}\n[[object]]\nname = \"floor\""), 1);
+    // A card after the block, turned away from the light: not part of any solid.
+    let card = "translate = [-1.2, 0.8, -0.3]\n\n[[object]]\nname = \"card\"\nmaterial = \"yellow\"\npolygons = [ [[-0.4,1.5,0.8],[0.4,1.5,0.8],[0.4,1.5,1.6],[-0.4,1.5,1.6]] ]\n";
+    let text = text.replacen("translate = [-1.2, 0.8, -0.3]\n", card, 1);
+    let mut scene = Scene::from_toml(&text, &path, path.parent().unwrap()).unwrap();
+    let mut c = scene.camera().clone();
+    (c.width, c.height) = (240, 180);
+    scene.set_camera(c).unwrap();
+    let render_with = |solid_cull| {
+        let shadows = ShadowMethod::BouknightKelley(BouknightKelleyOptions { solid_cull, ..Default::default() });
+        render(&scene, &RenderOptions { shadows, ..Default::default() }).unwrap()
+    };
+    let (on, off) = (render_with(true), render_with(false));
+    assert!(on.stats.shadow_counters.get("casters_dropped_facing_away") > 0, "the closed block is culled");
+    assert_eq!(on.frame.light, off.frame.light);
+    let differ = on.frame.color.iter().zip(&off.frame.color).filter(|(a, b)| a != b).count();
+    assert_eq!(differ, 0, "{differ} pixels differ");
+}
