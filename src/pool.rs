@@ -54,6 +54,29 @@ impl<B: Default> Kept<B> {
     }
 }
 
+impl<B: Clone> Kept<B> {
+    /// The kept item that `is` picks, or (when none is) `make`'s, kept from now on in place
+    /// of the least recently used when `limit` are kept already.
+    pub(crate) fn find_or_make(&self, is: impl Fn(&B) -> bool, make: impl FnOnce() -> B, limit: usize) -> B {
+        if let Ok(mut kept) = self.0.lock() {
+            if let Some(at) = kept.iter().position(is) {
+                // The most recently used last.
+                let found = kept.remove(at);
+                kept.push(found.clone());
+                return found;
+            }
+        }
+        let made = make();
+        if let Ok(mut kept) = self.0.lock() {
+            if kept.len() >= limit.max(1) {
+                kept.remove(0);
+            }
+            kept.push(made.clone());
+        }
+        made
+    }
+}
+
 /// Buffers of `T` kept for reuse.
 pub(crate) type Pool<T> = Kept<Vec<T>>;
 
@@ -132,6 +155,8 @@ pub(crate) struct Pools {
     pub(crate) screens: Kept<crate::view::Screen>,
     /// Watkins' per-band edge tables and span sets.
     pub(crate) scan_bands: Kept<crate::visibility::BandScratch>,
+    /// Shadow volumes' edge adjacency, of the scenes last rendered.
+    pub(crate) adjacency: Kept<crate::shadow::KeptAdjacency>,
 }
 
 impl Pools {

@@ -146,7 +146,7 @@ fn mirrored_scene(scene: &Scene, plane: &Plane, m: DMat4, reflect_lights: bool) 
         });
     }
     // Clipping by the mirror's plane opens solids, and the polygons are renumbered.
-    out.forget_solids();
+    out.polygons_changed();
     if reflect_lights {
         for l in &mut out.lights {
             l.kind = match l.kind {

@@ -478,6 +478,17 @@ pub struct Scene {
     pub(crate) solid_of: Vec<u32>,
     /// The closed, consistently wound surfaces among the objects' polygons.
     pub(crate) solids: Vec<Solid>,
+    /// Which compiled polygons these are: a number of its own for every compile (and every
+    /// change of the polygons since), shared by clones, so that what a renderer derives from
+    /// the polygons (Crow's edge adjacency) can be kept for the next frame of the same scene.
+    pub(crate) polygons_id: u64,
+}
+
+/// The next [`Scene::polygons_id`].
+static NEXT_POLYGONS_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+fn next_polygons_id() -> u64 {
+    NEXT_POLYGONS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 impl Scene {
@@ -528,6 +539,7 @@ impl Scene {
             face_count: 0,
             solid_of: Vec::new(),
             solids: Vec::new(),
+            polygons_id: next_polygons_id(),
         };
         scene.compile().map_err(Error::InvalidOption)?;
         Ok(scene)
@@ -754,12 +766,14 @@ impl Scene {
         &self.normals[p.start as usize..(p.start + p.len) as usize]
     }
 
-    /// Forgets the closed solids found at compile: for a scene whose polygons were changed
-    /// since (a mirror's scene: clipped, left out, renumbered), whose solids are not known.
-    pub(crate) fn forget_solids(&mut self) {
+    /// Records that the polygons were changed since compile (a mirror's scene: clipped, left
+    /// out, renumbered): the closed solids found then are forgotten (they are not known for
+    /// the new polygons), and the polygons take a new [`Scene::polygons_id`].
+    pub(crate) fn polygons_changed(&mut self) {
         self.solids.clear();
         self.solid_of.clear();
         self.solid_of.resize(self.polygons.len(), solids::NO_SOLID);
+        self.polygons_id = next_polygons_id();
     }
 
     /// Whether polygon `i` casts shadows.

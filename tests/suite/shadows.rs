@@ -393,3 +393,22 @@ fn v3(v: [f64; 3]) -> String {
 fn poly(f: &[[f64; 3]]) -> String {
     format!("[{}]", f.iter().map(|&v| v3(v)).collect::<Vec<_>>().join(", "))
 }
+
+/// A renderer keeps the shadow volumes' edge adjacency for the next frame of the same
+/// polygons, and only for them: one renderer drawing two scenes in turn (and the first again)
+/// draws each as a fresh render does.
+#[test]
+fn a_renderer_keeps_adjacency_only_for_the_same_polygons() {
+    let cubes = umbra::generate::cubes(3, true, 160, 120).unwrap();
+    let spheres = umbra::generate::spheres(800, 3, 160, 120).unwrap();
+    for shadows in [ShadowMethod::Crow(Default::default()), ShadowMethod::StencilVolume(Default::default())] {
+        let opts = umbra::RenderOptions { shadows, ..Default::default() };
+        let mut renderer = umbra::Renderer::new();
+        for scene in [&cubes, &spheres, &cubes, &spheres] {
+            let kept = renderer.render(scene, &opts).unwrap().frame.clone();
+            let fresh = umbra::render(scene, &opts).unwrap().frame;
+            assert_eq!(kept.light, fresh.light, "{}", opts.shadows.name());
+            assert_eq!(kept.id, fresh.id);
+        }
+    }
+}
