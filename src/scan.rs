@@ -256,7 +256,6 @@ pub struct ActiveEdges<'a> {
     end: u32,
     active: Vec<Crossing>,
     incoming: Vec<Crossing>,
-    merged: Vec<Crossing>,
     current: Option<u32>,
     /// Edges that entered so far (a counter for the stats).
     pub entered: u64,
@@ -285,16 +284,7 @@ impl<'a> ActiveEdges<'a> {
             }
             active.sort_unstable_by(|a, b| a.x.total_cmp(&b.x));
         }
-        ActiveEdges {
-            table,
-            next: start,
-            end,
-            active,
-            incoming: Vec::new(),
-            merged: Vec::new(),
-            current: None,
-            entered: 0,
-        }
+        ActiveEdges { table, next: start, end, active, incoming: Vec::new(), current: None, entered: 0 }
     }
 
     /// Advances to the next line: its index and its crossings in increasing x.
@@ -333,27 +323,29 @@ impl<'a> ActiveEdges<'a> {
             self.incoming.clear();
             self.incoming.extend(entering.iter().map(|e| Crossing::of(e, line)));
             self.incoming.sort_unstable_by(|a, b| a.x.total_cmp(&b.x));
-            self.merged.clear();
-            let (mut a, mut b) = (self.active.iter().peekable(), self.incoming.iter().peekable());
-            loop {
-                let next = match (a.peek(), b.peek()) {
-                    (Some(x), Some(y)) => {
-                        if y.x < x.x {
-                            b.next()
-                        } else {
-                            a.next()
-                        }
-                    }
-                    (Some(_), None) => a.next(),
-                    (None, Some(_)) => b.next(),
-                    (None, None) => break,
-                };
-                self.merged.extend(next.copied());
-            }
-            std::mem::swap(&mut self.active, &mut self.merged);
+            self.merge_incoming();
         }
         self.current = Some(line);
         Some((line, &self.active))
+    }
+
+    /// Merges the sorted `incoming` into the sorted `active` list, in place from the back:
+    /// the active edges left of every entering one are not moved (an entering edge goes after
+    /// the active edges at its own x).
+    fn merge_incoming(&mut self) {
+        let (mut i, mut j) = (self.active.len(), self.incoming.len());
+        self.active.extend_from_slice(&self.incoming);
+        let mut k = self.active.len();
+        while j > 0 {
+            k -= 1;
+            if i > 0 && self.active[i - 1].x > self.incoming[j - 1].x {
+                i -= 1;
+                self.active[k] = self.active[i];
+            } else {
+                j -= 1;
+                self.active[k] = self.incoming[j];
+            }
+        }
     }
 
     /// Steps forward to `line` (which must not be behind the last line walked) and gives its
@@ -369,7 +361,7 @@ impl<'a> ActiveEdges<'a> {
 
     /// Bytes held by the walker.
     pub fn bytes(&self) -> usize {
-        (self.active.capacity() + self.incoming.capacity() + self.merged.capacity()) * std::mem::size_of::<Crossing>()
+        (self.active.capacity() + self.incoming.capacity()) * std::mem::size_of::<Crossing>()
     }
 }
 
