@@ -4,6 +4,7 @@
 //! already has instead of having the system hand out and zero fresh ones (which, for a
 //! 1920x1080 frame, costs more than drawing a simple scene).
 
+use std::any::Any;
 use std::sync::{Arc, Mutex};
 
 /// Things kept for reuse (buffers, whole frames); clones share them.
@@ -39,41 +40,6 @@ impl<B> Kept<B> {
     /// The sum of `bytes` over what is kept.
     fn sum(&self, bytes: impl Fn(&B) -> usize) -> usize {
         self.0.lock().map_or(0, |kept| kept.iter().map(bytes).sum())
-    }
-}
-
-impl<B: Default> Kept<B> {
-    /// A kept item, or a new one when none is kept.
-    pub(crate) fn take_any(&self) -> B {
-        self.0.lock().ok().and_then(|mut kept| kept.pop()).unwrap_or_default()
-    }
-
-    /// Keeps `item` for a later frame.
-    pub(crate) fn put(&self, item: B) {
-        self.keep(item);
-    }
-}
-
-impl<B: Clone> Kept<B> {
-    /// The kept item that `is` picks, or (when none is) `make`'s, kept from now on in place
-    /// of the least recently used when `limit` are kept already.
-    pub(crate) fn find_or_make(&self, is: impl Fn(&B) -> bool, make: impl FnOnce() -> B, limit: usize) -> B {
-        if let Ok(mut kept) = self.0.lock() {
-            if let Some(at) = kept.iter().position(is) {
-                // The most recently used last.
-                let found = kept.remove(at);
-                kept.push(found.clone());
-                return found;
-            }
-        }
-        let made = make();
-        if let Ok(mut kept) = self.0.lock() {
-            if kept.len() >= limit.max(1) {
-                kept.remove(0);
-            }
-            kept.push(made.clone());
-        }
-        made
     }
 }
 
@@ -134,6 +100,60 @@ impl Kept<crate::frame::Frame> {
     }
 }
 
+/// Things of any type kept for reuse, found by their type: what a stage keeps for its next
+/// frame in types of its own (a band's edge table, the screen polygons, an edge adjacency),
+/// which this module need not know.
+#[derive(Clone, Default)]
+pub(crate) struct Stash(Arc<Mutex<Vec<Box<dyn Any + Send>>>>);
+
+impl Stash {
+    /// A kept `T` (the last kept), or a new one when none is.
+    pub(crate) fn take<T: Any + Send + Default>(&self) -> T {
+        let Ok(mut kept) = self.0.lock() else { return T::default() };
+        match kept.iter().rposition(|b| b.is::<T>()) {
+            Some(at) => kept.remove(at).downcast::<T>().map_or_else(|_| T::default(), |b| *b),
+            None => T::default(),
+        }
+    }
+
+    /// Keeps `item` for a later frame.
+    pub(crate) fn put<T: Any + Send>(&self, item: T) {
+        if let Ok(mut kept) = self.0.lock() {
+            kept.push(Box::new(item));
+        }
+    }
+
+    /// The kept `T` that `is` picks, or (when none is) `make`'s, kept from now on in place of
+    /// the least recently used `T` when `limit` are kept already.
+    pub(crate) fn find_or_make<T: Any + Send + Clone>(
+        &self,
+        is: impl Fn(&T) -> bool,
+        make: impl FnOnce() -> T,
+        limit: usize,
+    ) -> T {
+        if let Ok(mut kept) = self.0.lock() {
+            if let Some(at) = kept.iter().position(|b| b.downcast_ref::<T>().is_some_and(&is)) {
+                // The most recently used last.
+                let found = kept.remove(at);
+                let copy = found.downcast_ref::<T>().cloned();
+                kept.push(found);
+                if let Some(copy) = copy {
+                    return copy;
+                }
+            }
+        }
+        let made = make();
+        if let Ok(mut kept) = self.0.lock() {
+            let of_type: Vec<usize> = (0..kept.len()).filter(|&i| kept[i].is::<T>()).collect();
+            if of_type.len() >= limit.max(1) {
+                kept.remove(of_type[0]);
+            }
+            kept.push(Box::new(made.clone()));
+        }
+        made
+    }
+}
+
 /// The pools of every element type the pipeline's frame-sized buffers use.
 #[derive(Clone, Default)]
 pub(crate) struct Pools {
@@ -151,12 +171,8 @@ pub(crate) struct Pools {
     pub(crate) points: Pool<glam::DVec3>,
     /// Whole frames (what each mirror shows).
     pub(crate) frames: Frames,
-    /// The view's screen polygons.
-    pub(crate) screens: Kept<crate::view::Screen>,
-    /// Watkins' per-band edge tables and span sets.
-    pub(crate) scan_bands: Kept<crate::visibility::BandScratch>,
-    /// Shadow volumes' edge adjacency, of the scenes last rendered.
-    pub(crate) adjacency: Kept<crate::shadow::KeptAdjacency>,
+    /// What stages keep in types of their own.
+    pub(crate) stash: Stash,
 }
 
 impl Pools {
@@ -169,8 +185,6 @@ impl Pools {
             + self.masks.bytes()
             + self.points.bytes()
             + self.frames.bytes()
-            + self.screens.sum(crate::view::Screen::bytes)
-            + self.scan_bands.sum(crate::visibility::BandScratch::bytes)
     }
 }
 
@@ -192,5 +206,36 @@ mod tests {
         assert_eq!((again.as_ptr(), again.capacity()), (at, 1000), "the roomiest buffer comes first");
         assert_eq!(pool.take().capacity(), 10);
         assert!(pool.take().is_empty());
+    }
+
+    #[test]
+    fn a_stash_gives_back_by_type_and_keeps_the_most_recently_used() {
+        let stash = Stash::default();
+        assert_eq!(stash.take::<Vec<u8>>(), Vec::<u8>::new());
+        stash.put(vec![1u8, 2]);
+        stash.put(String::from("kept"));
+        assert_eq!(stash.take::<String>(), "kept");
+        assert_eq!(stash.take::<String>(), "", "taken once");
+        assert_eq!(stash.take::<Vec<u8>>(), vec![1, 2]);
+        // At most two (u32, &str) kept: the least recently used one goes.
+        let made = std::cell::Cell::new(0);
+        let get = |k: u32| {
+            stash.find_or_make(
+                |e: &(u32, &str)| e.0 == k,
+                || {
+                    made.set(made.get() + 1);
+                    (k, "made")
+                },
+                2,
+            )
+        };
+        for k in [1, 2, 1, 3] {
+            get(k);
+        }
+        assert_eq!(made.get(), 3, "1 was found again");
+        get(1);
+        assert_eq!(made.get(), 3, "1 was used more recently than 2, which went");
+        get(2);
+        assert_eq!(made.get(), 4);
     }
 }

@@ -253,7 +253,7 @@ fn frame_pass(
 
     let t = Instant::now();
     bar.phase("view: clipping and projecting");
-    let screen = view.screen_polygons_in(scene, pools.screens.take_any());
+    let screen = view.screen_polygons_in(scene, pools.stash.take());
     stats.visibility_counters.add("screen_polygons", screen.len() as u64);
     stats.time_ms.insert("view", ms(t.elapsed()));
 
@@ -302,7 +302,7 @@ fn frame_pass(
     let outlines = shadows.outlines();
     drop(shadows);
     drop(ctx);
-    pools.screens.put(screen);
+    pools.stash.put(screen);
     Ok((Rendered { frame, stats }, runs, outlines))
 }
 

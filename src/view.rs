@@ -154,12 +154,6 @@ impl Screen {
             })
             .collect()
     }
-
-    /// Bytes held.
-    pub fn bytes(&self) -> usize {
-        self.polygons.capacity() * std::mem::size_of::<ScreenPolygon>()
-            + self.points.capacity() * std::mem::size_of::<DVec2>()
-    }
 }
 
 impl std::ops::Index<usize> for Screen {

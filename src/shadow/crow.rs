@@ -51,7 +51,7 @@ impl<'a> Crow<'a> {
     pub fn new(ctx: &'a ShadowContext<'a>, options: VolumeOptions, counters: &mut Counters) -> Self {
         let counting = options.counting;
         let view = ctx.view;
-        let adjacency = Adjacency::kept(ctx.scene, options.silhouettes, &ctx.pools.adjacency);
+        let adjacency = Adjacency::kept(ctx.scene, options.silhouettes, &ctx.pools.stash);
         let samples = ctx
             .all_samples()
             .map(|(_, _, sample)| {

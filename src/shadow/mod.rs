@@ -27,7 +27,6 @@ pub(crate) use ray_cast::blocked;
 use ray_cast::RayCastShadows;
 use stencil_volume::StencilVolume;
 pub use volumes::Counting;
-pub(crate) use volumes::KeptAdjacency;
 use williams::Williams;
 pub use williams::{ShadowFilter, WilliamsOptions};
 

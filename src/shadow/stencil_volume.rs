@@ -43,7 +43,7 @@ impl<'a> StencilVolume<'a> {
             }
         }
         let planes: Vec<Option<DepthPlane>> = scene.polygons.iter().map(|p| view.depth_plane(&p.plane)).collect();
-        let adjacency = Adjacency::kept(scene, options.silhouettes, &ctx.pools.adjacency);
+        let adjacency = Adjacency::kept(scene, options.silhouettes, &ctx.pools.stash);
         let counting = options.counting;
         let band = crate::scan::band_height(h);
         let mut writes = 0u64;

@@ -46,7 +46,7 @@
 use super::projection::{edge_on, light_side, Projector};
 use super::ShadowContext;
 use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane};
-use crate::pool::Kept;
+use crate::pool::Stash;
 use crate::scene::LightSample;
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -369,17 +369,17 @@ struct KeyedEdge {
 /// not.
 ///
 /// [`Scene::polygons_id`]: crate::scene::Scene
-pub(crate) type KeptAdjacency = (u64, bool, Arc<Adjacency>);
+type KeptAdjacency = (u64, bool, Arc<Adjacency>);
 
 impl Adjacency {
     /// The adjacency of `scene` (as [`Adjacency::new`]), from `kept` when an earlier frame of
     /// the same polygons built it: it depends on the polygons alone, not on the camera or
     /// the lights.
-    pub(crate) fn kept(scene: &crate::scene::Scene, merge: bool, kept: &Kept<KeptAdjacency>) -> Arc<Adjacency> {
+    pub(crate) fn kept(scene: &crate::scene::Scene, merge: bool, kept: &Stash) -> Arc<Adjacency> {
         let id = scene.polygons_id;
         let is = |k: &KeptAdjacency| k.0 == id && k.1 == merge;
         // A few scenes: a frame and the scenes its mirrors show.
-        kept.find_or_make(is, || (id, merge, Arc::new(Adjacency::new(scene, merge))), 4).2
+        kept.find_or_make::<KeptAdjacency>(is, || (id, merge, Arc::new(Adjacency::new(scene, merge))), 4).2
     }
 
     /// The adjacency of the scene's shadow-casting polygons. Vertices are welded by exact

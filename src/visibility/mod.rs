@@ -7,8 +7,8 @@ mod scanline;
 mod zbuffer;
 
 use ray_cast::RayCastVisibility;
+pub(crate) use scanline::ScanlineVisibility;
 pub use scanline::SpanRecord;
-pub(crate) use scanline::{BandScratch, ScanlineVisibility};
 use zbuffer::ZBufferVisibility;
 
 use crate::pool::Pools;

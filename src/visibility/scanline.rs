@@ -15,7 +15,7 @@
 //! size, built by the thread that walks it, in memory kept from the last frame.
 
 use super::{push_run, Run, Visibility};
-use crate::pool::{Kept, Pools};
+use crate::pool::{Pools, Stash};
 use crate::scan::{band_height, boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::scene::Scene;
 use crate::stats::Counters;
@@ -31,24 +31,18 @@ pub struct ScanlineVisibility<'a> {
     band: u32,
     width: u32,
     height: u32,
-    scratch: Kept<BandScratch>,
+    /// Where the bands' working memory is kept between frames.
+    stash: Stash,
 }
 
 /// One band's working memory, kept between frames: its edge table, and its polygons' depth
 /// planes and scene indices (the table's tags index these), and the set of open polygons.
 #[derive(Default)]
-pub struct BandScratch {
+struct BandScratch {
     table: EdgeTable,
     planes: Vec<DepthPlane>,
     polys: Vec<u32>,
     set: OpenSet,
-}
-
-impl BandScratch {
-    /// Bytes held.
-    pub fn bytes(&self) -> usize {
-        self.table.bytes() + self.set.bytes() + (self.planes.capacity() * 3 + self.polys.capacity()) * 8
-    }
 }
 
 impl<'a> ScanlineVisibility<'a> {
@@ -65,7 +59,7 @@ impl<'a> ScanlineVisibility<'a> {
             band,
             width: view.width,
             height: view.height,
-            scratch: pools.scan_bands.clone(),
+            stash: pools.stash.clone(),
         }
     }
 
@@ -122,7 +116,7 @@ impl<'a> ScanlineVisibility<'a> {
     }
 
     fn walk_lines(&self, lines: Range<u32>, counters: &mut Counters, record: bool, f: &mut LineSink) {
-        let mut scratch = self.scratch.take_any();
+        let mut scratch: BandScratch = self.stash.take();
         self.build_band(&lines, &mut scratch);
         let BandScratch { table, planes, polys, set } = &mut scratch;
         counters.add("edges", table.len() as u64);
@@ -178,7 +172,7 @@ impl<'a> ScanlineVisibility<'a> {
         let band_bytes = table.bytes() + aet.bytes() + set.bytes() + runs.capacity() * std::mem::size_of::<Run>();
         counters.add("band_bytes_max", band_bytes as u64);
         drop(aet);
-        self.scratch.put(scratch);
+        self.stash.put(scratch);
     }
 }
 
