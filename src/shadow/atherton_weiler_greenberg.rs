@@ -437,7 +437,10 @@ const TILE_PIECES: usize = 128;
 /// sorted on their own, since what hides what inside one region depends only on what lies in
 /// it. A large polygon behind many small ones (a floor under a crowd) is then clipped only by
 /// those over each region, not by all of them in turn, and the regions are sorted in
-/// parallel.
+/// parallel. A region is not cut where cutting does not pay: where some quarter would hold
+/// every caster of the region, or the quarters together twice as many (casters larger than
+/// the quarters, as a stack of polygons covering one another is: cutting would only copy
+/// them, four times a level).
 fn regions(
     casters: Vec<Piece>,
     others: Vec<Piece>,
@@ -445,10 +448,6 @@ fn regions(
     depth: u32,
     out: &mut Vec<(Vec<Piece>, Vec<Piece>)>,
 ) {
-    if casters.len() <= TILE_PIECES || depth >= 16 {
-        out.push((casters, others));
-        return;
-    }
     let (lo, hi) = rect;
     let mid = (lo + hi) * 0.5;
     let quarters = [
@@ -457,6 +456,12 @@ fn regions(
         (DVec2::new(lo.x, mid.y), DVec2::new(mid.x, hi.y)),
         (mid, hi),
     ];
+    let counts = quarters.map(|q| casters.iter().filter(|p| touches(p.bounds, q)).count());
+    let pays = counts.iter().all(|&c| c < casters.len()) && counts.iter().sum::<usize>() <= 2 * casters.len();
+    if casters.len() <= TILE_PIECES || depth >= 16 || !pays {
+        out.push((casters, others));
+        return;
+    }
     let (cs, os) = (into_quarters(casters, &quarters), into_quarters(others, &quarters));
     for ((c, o), q) in cs.into_iter().zip(os).zip(quarters) {
         regions(c, o, q, depth + 1, out);
@@ -466,8 +471,6 @@ fn regions(
 /// Each piece into the quarters its box overlaps, cut to each when it crosses a border.
 fn into_quarters(pieces: Vec<Piece>, quarters: &[(DVec2, DVec2); 4]) -> [Vec<Piece>; 4] {
     let mut out: [Vec<Piece>; 4] = Default::default();
-    let touches =
-        |b: (DVec2, DVec2), q: (DVec2, DVec2)| b.0.x < q.1.x && b.1.x > q.0.x && b.0.y < q.1.y && b.1.y > q.0.y;
     for p in pieces {
         let hit: smallvec::SmallVec<[usize; 4]> = (0..4).filter(|&k| touches(p.bounds, quarters[k])).collect();
         if let [k] = hit[..] {
@@ -479,6 +482,11 @@ fn into_quarters(pieces: Vec<Piece>, quarters: &[(DVec2, DVec2); 4]) -> [Vec<Pie
         }
     }
     out
+}
+
+/// Whether the box `b` overlaps the rectangle `q` (both as (least, greatest) corners).
+fn touches(b: (DVec2, DVec2), q: (DVec2, DVec2)) -> bool {
+    b.0.x < q.1.x && b.1.x > q.0.x && b.0.y < q.1.y && b.1.y > q.0.y
 }
 
 /// `region` cut to the rectangle `(lo, hi)`, ring by ring (Sutherland-Hodgman; the even-odd

@@ -412,3 +412,18 @@ fn a_renderer_keeps_adjacency_only_for_the_same_polygons() {
         }
     }
 }
+
+/// A stack of polygons covering one another (200 quads, more than a light-view region keeps)
+/// is not cut into regions that only copy it: the light view stays a handful of regions (it
+/// was once cut four ways sixteen levels deep, until memory ran out), and the light agrees
+/// with Bouknight-Kelley's at every pixel.
+#[test]
+fn a_stack_of_covering_polygons_is_not_cut_without_end() {
+    let scene = umbra::generate::stacked_quads(200, 160, 90).unwrap();
+    let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg, ..Default::default() };
+    let awg = umbra::render(&scene, &opts).unwrap();
+    let tiles = awg.stats.shadow_counters.get("light_view_tiles");
+    assert!((1..=16).contains(&tiles), "{tiles} regions");
+    let bk = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::BouknightKelley(Default::default()));
+    assert_light_agree(&scene, &bk, &awg.frame, "stacked quads against bouknight-kelley");
+}
