@@ -405,7 +405,10 @@ fn lit_in_view(
     let all = casters.iter().chain(&others).map(|p| p.bounds);
     let rect = all.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
     let mut lists = Vec::new();
-    regions(casters, others, rect, 0, &mut lists);
+    // Cutting may copy pieces that straddle a border: at most three more copies in all than
+    // there are pieces, however the cuts fall.
+    let mut copies = 3 * (casters.len() + others.len());
+    regions(casters, others, rect, &mut copies, &mut lists);
     stats.tiles += lists.len() as u64;
     let done: Vec<(Vec<Piece>, Pass1)> = lists
         .into_par_iter()
@@ -440,12 +443,13 @@ const TILE_PIECES: usize = 128;
 /// parallel. A region is not cut where cutting does not pay: where some quarter would hold
 /// every caster of the region, or the quarters together twice as many (casters larger than
 /// the quarters, as a stack of polygons covering one another is: cutting would only copy
-/// them, four times a level).
+/// them, four times a level), nor once the cuts have made `copies` copies of straddling
+/// pieces.
 fn regions(
     casters: Vec<Piece>,
     others: Vec<Piece>,
     rect: (DVec2, DVec2),
-    depth: u32,
+    copies: &mut usize,
     out: &mut Vec<(Vec<Piece>, Vec<Piece>)>,
 ) {
     let (lo, hi) = rect;
@@ -456,15 +460,20 @@ fn regions(
         (DVec2::new(lo.x, mid.y), DVec2::new(mid.x, hi.y)),
         (mid, hi),
     ];
-    let counts = quarters.map(|q| casters.iter().filter(|p| touches(p.bounds, q)).count());
-    let pays = counts.iter().all(|&c| c < casters.len()) && counts.iter().sum::<usize>() <= 2 * casters.len();
-    if casters.len() <= TILE_PIECES || depth >= 16 || !pays {
+    let count = |pieces: &[Piece], q| pieces.iter().filter(|p| touches(p.bounds, q)).count();
+    let counts = quarters.map(|q| count(&casters, q));
+    let (held, others_held) =
+        (counts.iter().sum::<usize>(), quarters.iter().map(|&q| count(&others, q)).sum::<usize>());
+    let made = (held + others_held).saturating_sub(casters.len() + others.len());
+    let pays = counts.iter().all(|&c| c < casters.len()) && held <= 2 * casters.len() && made <= *copies;
+    if casters.len() <= TILE_PIECES || !pays {
         out.push((casters, others));
         return;
     }
+    *copies -= made;
     let (cs, os) = (into_quarters(casters, &quarters), into_quarters(others, &quarters));
     for ((c, o), q) in cs.into_iter().zip(os).zip(quarters) {
-        regions(c, o, q, depth + 1, out);
+        regions(c, o, q, copies, out);
     }
 }
 
