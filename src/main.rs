@@ -69,8 +69,9 @@ struct ShadowArgs {
     #[arg(long, default_value = "zpass", value_parser = parse::<Counting>)]
     crow_count: Counting,
     /// Crow and stencil-volume: give every polygon its own volume instead of merging the
-    /// sides that neighbouring polygons share (to measure what merging saves: only
-    /// silhouette and boundary edges keep sides).
+    /// sides that neighbouring polygons share and leaving out closed solids' polygons turned
+    /// away from the light (to measure what that saves: merged, only silhouette and boundary
+    /// edges keep sides).
     #[arg(long)]
     no_silhouettes: bool,
     /// Williams: texels along each side of a shadow map.

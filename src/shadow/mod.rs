@@ -66,8 +66,9 @@ pub struct VolumeOptions {
     /// How the volumes are counted along the line of sight (default z-pass).
     pub counting: volumes::Counting,
     /// Merge the sides that neighbouring polygons share, so that only silhouette and
-    /// boundary edges keep sides (default true); `false` gives every polygon its own volume,
-    /// to measure the saving.
+    /// boundary edges keep sides, and leave out the polygons of closed solids turned away
+    /// from the light (default true); `false` gives every polygon its own volume, to measure
+    /// the saving.
     pub silhouettes: bool,
 }
 

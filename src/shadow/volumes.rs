@@ -43,7 +43,7 @@
 //! everything, so z-pass needs neither. Z-fail counts what lies behind the visible point, so
 //! it needs the sides and both caps, and no near caps. Naive z-pass leaves the near caps out.
 
-use super::projection::{edge_on, light_side, Projector};
+use super::projection::{edge_on, faces_away_on_solid, light_side, Projector};
 use super::ShadowContext;
 use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane};
 use crate::pool::Stash;
@@ -125,7 +125,11 @@ pub fn shadow_polygons(
     counters: &mut Counters,
 ) -> Vec<ShadowPolygon> {
     let mut b = Builder::new(ctx, sample, counting);
-    let casts = |i: usize| !edge_on(ctx.scene, i, sample, ctx.extent);
+    // With merged volumes, a closed solid's polygons turned away from the light are left out
+    // (ours): every shadow ray crossing one has crossed, nearer the light, one of the same
+    // solid turned toward it, so the counts change but never between zero and not zero.
+    let culled = |i: usize| adjacency.merged_volumes && faces_away_on_solid(ctx.scene, i, sample);
+    let casts = |i: usize| !edge_on(ctx.scene, i, sample, ctx.extent) && !culled(i);
     // Step 1: the merged sides, one per edge whose net weight is not zero.
     let (mut weight1, mut weight2) = (0u64, 0u64);
     for e in &adjacency.edges {
@@ -324,6 +328,8 @@ fn finite(v: DVec3) -> DVec4 {
 /// light.
 #[derive(Debug, Clone, Default)]
 pub struct Adjacency {
+    /// Whether coincident sides are merged (else every polygon keeps its own volume).
+    merged_volumes: bool,
     /// Every edge of a merged polygon, once.
     edges: Vec<MergedEdge>,
     /// The polygons sharing each edge (`edges[i].first..+count`).
@@ -385,7 +391,7 @@ impl Adjacency {
     /// The adjacency of the scene's shadow-casting polygons. Vertices are welded by exact
     /// position. Without `merge`, every polygon keeps its own volume (to measure the saving).
     pub fn new(scene: &crate::scene::Scene, merge: bool) -> Self {
-        let mut adjacency = Adjacency::default();
+        let mut adjacency = Adjacency { merged_volumes: merge, ..Default::default() };
         let mut keyed = Vec::new();
         for (p, poly) in scene.polygons.iter().enumerate() {
             if !scene.casts_shadows(p) {
