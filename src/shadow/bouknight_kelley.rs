@@ -133,6 +133,7 @@ fn shadow_polygons(
         counters.add("pairs_kept_by_prefilter", total.kept);
     }
     counters.add("pairs_dropped_behind", total.behind);
+    counters.add("pairs_outside_receiver", total.outside);
     counters.add("projections_empty", total.empty);
     counters.add("shadow_polygons", overlay.len() as u64);
     counters.add("prefilter_cpu_us", total.prefilter_ns / 1000);
@@ -160,6 +161,7 @@ fn project_onto(
     let plane = scene.polygons[b as usize].plane;
     let side = light_side(&plane, sample);
     let rect = bounding_rectangle(scene.verts(b as usize), &plane);
+    let wedge = Wedge::of(scene.verts(b as usize), sample, ctx.extent);
     for a in candidates {
         if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
             continue;
@@ -173,6 +175,8 @@ fn project_onto(
             if record {
                 pairs.behind.push(a);
             }
+        } else if wedge.as_ref().is_some_and(|w| w.misses(scene.verts(a as usize))) {
+            tally.outside += 1;
         } else if !proj.project(scene.verts(a as usize), &plane, &rect, sample) {
             tally.empty += 1;
         } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
@@ -215,6 +219,7 @@ fn merge(
 struct Tally {
     kept: u64,
     behind: u64,
+    outside: u64,
     empty: u64,
     prefilter_ns: u64,
     projection_ns: u64,
@@ -224,9 +229,45 @@ impl Tally {
     fn add(&mut self, o: &Tally) {
         self.kept += o.kept;
         self.behind += o.behind;
+        self.outside += o.outside;
         self.empty += o.empty;
         self.prefilter_ns += o.prefilter_ns;
         self.projection_ns += o.projection_ns;
+    }
+}
+
+/// The wedge a triangle receiver cuts from the light (ours, not the paper's): the three
+/// planes through the light and each of its edges, facing out. A caster wholly and strictly
+/// outside one of them is seen from the light beside the receiver, never over it: its
+/// shadow on the receiver's plane lies outside the receiver, so it is not projected. (The
+/// paper projects it onto the receiver's plane and finds the projection beside it.)
+struct Wedge {
+    /// Each plane's unit normal (pointing out) and a point on it.
+    planes: [(DVec3, DVec3); 3],
+    /// How far outside a caster's corners must lie: rounding never decides a pair.
+    margin: f64,
+}
+
+impl Wedge {
+    /// The wedge of receiver `verts`, when it is a triangle the light does not see edge-on.
+    fn of(verts: &[DVec3], sample: LightSample, extent: f64) -> Option<Wedge> {
+        let [a, b, c] = verts else { return None };
+        let plane = |p: DVec3, q: DVec3, opposite: DVec3| {
+            let along = match sample {
+                LightSample::Point(s) => s - p,
+                LightSample::Directional(d) => d,
+            };
+            let n = (q - p).cross(along).normalize_or_zero();
+            let inside = n.dot(opposite - p);
+            (inside != 0.0 && n != DVec3::ZERO).then(|| (if inside > 0.0 { -n } else { n }, p))
+        };
+        let planes = [plane(*a, *b, *c)?, plane(*b, *c, *a)?, plane(*c, *a, *b)?];
+        Some(Wedge { planes, margin: 1e-9 * extent })
+    }
+
+    /// Whether every corner of `verts` lies outside one and the same plane of the wedge.
+    fn misses(&self, verts: &[DVec3]) -> bool {
+        self.planes.iter().any(|&(n, p)| verts.iter().all(|&v| n.dot(v - p) > self.margin))
     }
 }
 

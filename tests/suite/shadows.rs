@@ -107,6 +107,9 @@ fn solid_cull_is_exercised_on_closed_meshes() {
         assert!(dropped * 3 > casters, "generated {i}: dropped {dropped} of {casters} casters");
         assert_eq!(on.stats.shadow_counters.get("casters") + dropped, casters, "generated {i}");
         assert!(on.stats.shadow_counters.get("shadow_polygons") < off.stats.shadow_counters.get("shadow_polygons"));
+        // The receiver wedge is at work on these triangles too (the exact set checks it).
+        let outside = off.stats.shadow_counters.get("pairs_outside_receiver");
+        assert!(outside > 0, "generated {i}: no caster found beside its receiver's wedge");
     }
 }
 
