@@ -191,30 +191,47 @@ fn probe(rings: &[&Ring], i: usize) -> DVec2 {
     order.iter().map(|&k| mid(k)).find(|&p| !shared(p)).unwrap_or(first)
 }
 
-/// Vertices, merged within the tolerance (a grid of cells one tolerance wide).
+/// Vertices, merged within the tolerance (a grid of cells one tolerance wide). Each cell
+/// holds the last vertex put in it, and each vertex the one put in its cell before it.
 struct Vertices {
     pts: Vec<DVec2>,
-    grid: HashMap<(i64, i64), Vec<u32>>,
+    grid: HashMap<(i64, i64), u32>,
+    /// `before[i]`: the vertex put in vertex `i`'s cell before it, or [`NONE`].
+    before: Vec<u32>,
     eps: f64,
 }
 
+/// No vertex.
+const NONE: u32 = u32::MAX;
+
 impl Vertices {
+    fn new(eps: f64) -> Self {
+        Vertices { pts: Vec::new(), grid: HashMap::default(), before: Vec::new(), eps }
+    }
+
     fn id(&mut self, p: DVec2) -> u32 {
         let cell = ((p.x / self.eps).floor() as i64, (p.y / self.eps).floor() as i64);
         for dx in -1..=1 {
             for dy in -1..=1 {
                 // Saturating: far-off points share the edge cells, and the distance test
                 // below still decides.
-                if let Some(ids) = self.grid.get(&(cell.0.saturating_add(dx), cell.1.saturating_add(dy))) {
-                    if let Some(&i) = ids.iter().find(|&&i| self.pts[i as usize].distance(p) <= self.eps) {
-                        return i;
+                let mut i = self.grid.get(&(cell.0.saturating_add(dx), cell.1.saturating_add(dy))).copied();
+                // The cell's vertices, first put first (as they were found before).
+                let mut found = None;
+                while let Some(k) = i.filter(|&k| k != NONE) {
+                    if self.pts[k as usize].distance(p) <= self.eps {
+                        found = Some(k);
                     }
+                    i = Some(self.before[k as usize]);
+                }
+                if let Some(k) = found {
+                    return k;
                 }
             }
         }
         let i = self.pts.len() as u32;
         self.pts.push(p);
-        self.grid.entry(cell).or_default().push(i);
+        self.before.push(self.grid.insert(cell, i).unwrap_or(NONE));
         i
     }
 }
@@ -245,11 +262,12 @@ pub fn clip(subject: &Region, clip: &Region) -> Result<Clipped, ClipError> {
             outside: Region { rings: s_rings.into_iter().chain(far).collect() },
         });
     }
-    let mut verts = Vertices { pts: Vec::new(), grid: HashMap::default(), eps };
+    let mut verts = Vertices::new(eps);
     let se = edges_of(&s_rings, &mut verts);
     let ce = edges_of(&c_rings, &mut verts);
     let (se, ce) = split_where_they_meet(se, ce, &mut verts);
-    let (sp, cp) = (pieces(&se), pieces(&ce));
+    let (mut se, mut ce) = (se, ce);
+    let (sp, cp) = (pieces(&mut se), pieces(&mut ce));
     let (inside, outside) = classify(&verts.pts, &sp, &cp);
     // Step 3: trace.
     let mut outside = trace(&verts.pts, &outside, eps)?;
@@ -344,14 +362,13 @@ fn split_where_they_meet(se: Vec<Edge>, ce: Vec<Edge>, verts: &mut Vertices) -> 
 
 /// The sub-edges of split edges, with pieces that run both ways within one region (bridges)
 /// cancelled.
-fn pieces(edges: &[Edge]) -> Vec<(u32, u32)> {
+fn pieces(edges: &mut [Edge]) -> Vec<(u32, u32)> {
     let mut count: HashMap<(u32, u32), i32> = HashMap::default();
     let mut order = Vec::new();
     for e in edges {
-        let mut s = e.splits.clone();
-        s.sort_by(|x, y| x.0.total_cmp(&y.0));
+        e.splits.sort_by(|x, y| x.0.total_cmp(&y.0));
         let mut prev = e.a;
-        for (_, v) in s.into_iter().chain([(1.0, e.b)]) {
+        for &(_, v) in e.splits.iter().chain(&[(1.0, e.b)]) {
             if v != prev {
                 let key = (prev.min(v), prev.max(v));
                 let c = count.entry(key).or_insert_with(|| {
@@ -483,22 +500,27 @@ fn split_pair(e: &mut Edge, f: &mut Edge, verts: &mut Vertices) {
 /// Closes directed edges into rings: at each vertex the next edge is the unused one that
 /// turns furthest left. An error when edges do not balance at some vertex.
 pub(crate) fn trace(pts: &[DVec2], edges: &[(u32, u32)], eps: f64) -> Result<Region, ClipError> {
-    let mut out_of: HashMap<u32, Vec<usize>> = HashMap::default();
-    let mut into: HashMap<u32, usize> = HashMap::default();
-    for (i, &(a, b)) in edges.iter().enumerate() {
-        out_of.entry(a).or_default().push(i);
-        *into.entry(b).or_default() += 1;
+    // The edges leaving each vertex, in order (`outs[first[v]..first[v + 1]]`), and how many
+    // arrive at it.
+    let mut first = vec![0usize; pts.len() + 1];
+    let mut inbound = vec![0usize; pts.len()];
+    for &(a, b) in edges {
+        first[a as usize + 1] += 1;
+        inbound[b as usize] += 1;
     }
-    for (&v, outs) in &out_of {
-        let inbound = into.get(&v).copied().unwrap_or(0);
-        if inbound != outs.len() {
-            let p = pts[v as usize];
-            return Err(ClipError::Unbalanced { x: p.x, y: p.y, inbound, outbound: outs.len() });
-        }
+    for v in 0..pts.len() {
+        first[v + 1] += first[v];
     }
-    if let Some((&v, &inbound)) = into.iter().find(|(v, _)| !out_of.contains_key(v)) {
+    let mut outs = vec![0usize; edges.len()];
+    let mut next = first.clone();
+    for (i, &(a, _)) in edges.iter().enumerate() {
+        outs[next[a as usize]] = i;
+        next[a as usize] += 1;
+    }
+    let out_of = |v: u32| &outs[first[v as usize]..first[v as usize + 1]];
+    if let Some(v) = (0..pts.len() as u32).find(|&v| out_of(v).len() != inbound[v as usize]) {
         let p = pts[v as usize];
-        return Err(ClipError::Unbalanced { x: p.x, y: p.y, inbound, outbound: 0 });
+        return Err(ClipError::Unbalanced { x: p.x, y: p.y, inbound: inbound[v as usize], outbound: out_of(v).len() });
     }
     let mut used = vec![false; edges.len()];
     let mut region = Region::default();
@@ -514,7 +536,7 @@ pub(crate) fn trace(pts: &[DVec2], edges: &[(u32, u32)], eps: f64) -> Result<Reg
             let (a, b) = edges[e];
             ring.push(pts[a as usize]);
             let dir_in = pts[b as usize] - pts[a as usize];
-            let next = out_of[&b].iter().copied().filter(|&k| !used[k]).max_by(|&x, &y| {
+            let next = out_of(b).iter().copied().filter(|&k| !used[k]).max_by(|&x, &y| {
                 let turn = |k: usize| {
                     let d = pts[edges[k].1 as usize] - pts[b as usize];
                     dir_in.perp_dot(d).atan2(dir_in.dot(d))
