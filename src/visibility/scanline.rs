@@ -228,11 +228,36 @@ impl Walk<'_> {
         best
     }
 
+    /// [`Walk::nearest`] at pixels `a` and `b` in one pass over the set.
+    #[inline]
+    fn nearest_at_both_ends(&mut self, set: &[u32], a: u32, b: u32) -> (u32, u32) {
+        let (xa, xb) = (a as f64 + 0.5, b as f64 + 0.5);
+        self.depth_tests += 2 * set.len() as u64;
+        let first = &self.planes[set[0] as usize];
+        let (mut left, mut right) = (set[0], set[0]);
+        let (mut left_z, mut right_z) = (first.inv_z(xa, self.yc), first.inv_z(xb, self.yc));
+        for &i in &set[1..] {
+            let plane = &self.planes[i as usize];
+            let (za, zb) = (plane.inv_z(xa, self.yc), plane.inv_z(xb, self.yc));
+            if za > left_z || (za == left_z && i < left) {
+                (left, left_z) = (i, za);
+            }
+            if zb > right_z || (zb == right_z && i < right) {
+                (right, right_z) = (i, zb);
+            }
+        }
+        (left, right)
+    }
+
     /// Resolves span `a..b` covered by `set`, splitting it where the nearest polygon changes.
     fn resolve(&mut self, set: &[u32], a: u32, b: u32, depth: u32, runs: &mut Vec<Run>) {
         self.spans += 1;
-        let left = self.nearest(set, a);
-        let right = if b - a == 1 { left } else { self.nearest(set, b - 1) };
+        let (left, right) = if b - a == 1 {
+            let one = self.nearest(set, a);
+            (one, one)
+        } else {
+            self.nearest_at_both_ends(set, a, b - 1)
+        };
         let split = (left != right).then(|| {
             // The two winners' inverse depths are equal at x* (they interpenetrate there).
             let (l, r) = (&self.planes[left as usize], &self.planes[right as usize]);
