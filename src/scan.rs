@@ -295,19 +295,26 @@ impl<'a> ActiveEdges<'a> {
         let line = self.next;
         self.next += 1;
         // Edges whose last line has passed leave; the others step to this line (one pass).
+        // An edge moves only when one before it has left.
         let mut kept = 0;
         for i in 0..self.active.len() {
-            let mut c = self.active[i];
-            if c.end > line {
+            if self.active[i].end > line {
+                if kept != i {
+                    self.active[kept] = self.active[i];
+                }
+                let c = &mut self.active[kept];
                 c.x = c.at(line);
-                self.active[kept] = c;
                 kept += 1;
             }
         }
         self.active.truncate(kept);
         // Insertion sort: the list was sorted on the previous line, and only edges that
-        // cross each other between two lines are out of order now.
+        // cross each other between two lines are out of order now (the others are passed
+        // over without being moved).
         for i in 1..self.active.len() {
+            if self.active[i - 1].x <= self.active[i].x {
+                continue;
+            }
             let item = self.active[i];
             let mut j = i;
             while j > 0 && self.active[j - 1].x > item.x {
