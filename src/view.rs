@@ -76,6 +76,9 @@ pub(crate) struct ScreenPolygon {
 pub(crate) struct Screen {
     polygons: Vec<ScreenPolygon>,
     points: Vec<DVec2>,
+    /// Scratch: each chunk's polygons before they are joined, kept with the screen so that
+    /// the next frame clips into memory it already has.
+    chunks: Vec<Screen>,
 }
 
 impl Screen {
@@ -345,29 +348,27 @@ impl View {
     /// clipped and projected in parallel, in chunks of polygons, then joined in order.
     pub(crate) fn screen_polygons_in(&self, scene: &Scene, mut kept: Screen) -> Screen {
         const CHUNK: usize = 1 << 12;
-        let parts: Vec<Screen> = scene
-            .polygons
-            .par_chunks(CHUNK)
-            .enumerate()
-            .map(|(c, chunk)| {
-                let (mut scratch, mut ring, mut part) = ([Vec::new(), Vec::new()], Vec::new(), Screen::default());
-                for (i, p) in (c * CHUNK..).zip(chunk) {
-                    let Some(depth) = self.depth_plane(&p.plane) else {
-                        continue;
-                    };
-                    if self.clip_project(scene.verts(i), &mut scratch, &mut ring) {
-                        part.push(i as u32, &ring, depth);
-                    }
+        let mut chunks = std::mem::take(&mut kept.chunks);
+        chunks.resize_with(scene.polygons.len().div_ceil(CHUNK), Screen::default);
+        scene.polygons.par_chunks(CHUNK).zip(chunks.par_iter_mut()).enumerate().for_each(|(c, (polygons, part))| {
+            let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
+            part.clear();
+            for (i, p) in (c * CHUNK..).zip(polygons) {
+                let Some(depth) = self.depth_plane(&p.plane) else {
+                    continue;
+                };
+                if self.clip_project(scene.verts(i), &mut scratch, &mut ring) {
+                    part.push(i as u32, &ring, depth);
                 }
-                part
-            })
-            .collect();
+            }
+        });
         kept.clear();
-        kept.polygons.reserve(parts.iter().map(Screen::len).sum());
-        kept.points.reserve(parts.iter().map(|p| p.points.len()).sum());
-        for part in &parts {
+        kept.polygons.reserve(chunks.iter().map(Screen::len).sum());
+        kept.points.reserve(chunks.iter().map(|p| p.points.len()).sum());
+        for part in &chunks {
             kept.append(part);
         }
+        kept.chunks = chunks;
         kept
     }
 }
