@@ -253,7 +253,7 @@ fn frame_pass(
 
     let t = Instant::now();
     bar.phase("view: clipping and projecting");
-    let screen = view.screen_polygons_in(scene, pools.stash.take());
+    let screen = view.screen_polygons_in(scene, |_| true, pools.stash.take());
     stats.visibility_counters.add("screen_polygons", screen.len() as u64);
     stats.time_ms.insert("view", ms(t.elapsed()));
 

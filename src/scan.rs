@@ -56,8 +56,15 @@ impl Edge {
 
     #[inline]
     fn x_at(&self, line: u32) -> f64 {
-        self.x_top + (line as f64 + 0.5 - self.y_top) * self.dxdy
+        x_on(self.x_top, self.y_top, self.dxdy, line)
     }
+}
+
+/// Where the edge through `(x_top, y_top)` with slope `dxdy` crosses the centre of `line`,
+/// evaluated from its top vertex (so every holder of the edge gets the same bits).
+#[inline]
+fn x_on(x_top: f64, y_top: f64, dxdy: f64, line: u32) -> f64 {
+    x_top + (line as f64 + 0.5 - y_top) * dxdy
 }
 
 /// Where an edge of polygon `tag` crosses the current scanline.
@@ -83,11 +90,10 @@ impl Crossing {
         Crossing { x: e.x_at(line), tag: e.tag, end: e.end, x_top: e.x_top, y_top: e.y_top, dxdy: e.dxdy }
     }
 
-    /// The same edge's crossing with `line`: the same arithmetic as [`Edge::x_at`], so the
-    /// same bits.
+    /// The same edge's crossing with `line`, as [`Edge::x_at`] finds it.
     #[inline]
     fn at(&self, line: u32) -> f64 {
-        self.x_top + (line as f64 + 0.5 - self.y_top) * self.dxdy
+        x_on(self.x_top, self.y_top, self.dxdy, line)
     }
 }
 

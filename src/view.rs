@@ -341,19 +341,25 @@ impl View {
 
     /// Every polygon of the scene that survives clipping, in screen space.
     pub(crate) fn screen_polygons(&self, scene: &Scene) -> Screen {
-        self.screen_polygons_in(scene, Screen::default())
+        self.screen_polygons_in(scene, |_| true, Screen::default())
     }
 
-    /// [`View::screen_polygons`] into the memory of `kept` (a screen of an earlier frame):
-    /// clipped and projected in parallel, in chunks of polygons, then joined in order.
-    pub(crate) fn screen_polygons_in(&self, scene: &Scene, mut kept: Screen) -> Screen {
+    /// The scene polygons `keep` picks that survive clipping, in screen space, in the memory
+    /// of `kept` (a screen of an earlier frame): clipped and projected in parallel, in chunks
+    /// of polygons, then joined in order.
+    pub(crate) fn screen_polygons_in(
+        &self,
+        scene: &Scene,
+        keep: impl Fn(usize) -> bool + Sync,
+        mut kept: Screen,
+    ) -> Screen {
         const CHUNK: usize = 1 << 12;
         let mut chunks = std::mem::take(&mut kept.chunks);
         chunks.resize_with(scene.polygons.len().div_ceil(CHUNK), Screen::default);
         scene.polygons.par_chunks(CHUNK).zip(chunks.par_iter_mut()).enumerate().for_each(|(c, (polygons, part))| {
             let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
             part.clear();
-            for (i, p) in (c * CHUNK..).zip(polygons) {
+            for (i, p) in (c * CHUNK..).zip(polygons).filter(|&(i, _)| keep(i)) {
                 let Some(depth) = self.depth_plane(&p.plane) else {
                     continue;
                 };

@@ -51,6 +51,7 @@ use crate::scene::LightSample;
 use crate::stats::Counters;
 use crate::view::DepthPlane;
 use glam::{DVec2, DVec3, DVec4};
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// How a count is taken along the line of sight.
@@ -129,7 +130,12 @@ pub fn shadow_polygons(
     // (ours): every shadow ray crossing one has crossed, nearer the light, one of the same
     // solid turned toward it, so the counts change but never between zero and not zero.
     let culled = |i: usize| adjacency.merged_volumes && faces_away_on_solid(ctx.scene, i, sample);
-    let casts = |i: usize| !edge_on(ctx.scene, i, sample, ctx.extent) && !culled(i);
+    // Decided once a polygon: each is asked for on every edge it has.
+    let casting: Vec<bool> = (0..ctx.scene.polygons.len())
+        .into_par_iter()
+        .map(|i| !edge_on(ctx.scene, i, sample, ctx.extent) && !culled(i))
+        .collect();
+    let casts = |i: usize| casting[i];
     // Step 1: the merged sides, one per edge whose net weight is not zero.
     let (mut weight1, mut weight2) = (0u64, 0u64);
     for e in &adjacency.edges {

@@ -247,25 +247,15 @@ impl DepthMap {
     fn render(ctx: &ShadowContext, proj: Projection, sample: LightSample, o: &WilliamsOptions) -> DepthMap {
         let size = o.map_size;
         let scene = ctx.scene;
-        let casters = (0..scene.polygons.len()).filter(|&i| {
+        let casts = |i: usize| {
             let plane = &scene.polygons[i].plane;
             scene.casts_shadows(i) && !(o.cull_front && sample.side_of(plane) > 0.0)
-        });
-        let mut screen = Screen::default();
-        match &proj {
-            Projection::Perspective(view) => {
-                let mut scratch = [Vec::new(), Vec::new()];
-                let mut ring = Vec::new();
-                for i in casters {
-                    let Some(depth) = view.depth_plane(&scene.polygons[i].plane) else { continue };
-                    if view.clip_project(scene.verts(i), &mut scratch, &mut ring) {
-                        screen.push(i as u32, &ring, depth);
-                    }
-                }
-            }
+        };
+        let screen = match &proj {
+            Projection::Perspective(view) => view.screen_polygons_in(scene, casts, ctx.pools.stash.take()),
             Projection::Ortho { u, v, u0, v0, texel, .. } => {
-                let mut ring = Vec::new();
-                for i in casters {
+                let (mut screen, mut ring) = (Screen::default(), Vec::new());
+                for i in (0..scene.polygons.len()).filter(|&i| casts(i)) {
                     let Some(depth) = proj.depth_plane(&scene.polygons[i].plane) else { continue };
                     ring.clear();
                     ring.extend(
@@ -273,10 +263,12 @@ impl DepthMap {
                     );
                     screen.push(i as u32, &ring, depth);
                 }
+                screen
             }
-        }
+        };
         let storage = ctx.pools.f32.clone();
         let nearness = rasterize::<f32>(&screen, size + PAD, size, None, storage.take()).depth;
+        ctx.pools.stash.put(screen);
         DepthMap { rows: proj.rows(), proj, size, nearness, storage }
     }
 

@@ -8,7 +8,6 @@
 //! line, so if one polygon is nearest at both ends it is nearest throughout; if not, the two
 //! winners' depths cross inside the span (interpenetration), and the span is split where they
 //! cross and each part is solved again — Watkins' subdivision.
-
 //!
 //! The frame is walked in bands of lines, in parallel. Each band builds its own edge table
 //! from the polygons that reach it, with their edges cut to its lines: a table a band's
@@ -196,6 +195,13 @@ pub struct SpanRecord {
 /// Receives each line's runs and, when recording, its spans.
 type LineSink<'f> = dyn FnMut(u32, &[Run], &[SpanRecord]) + 'f;
 
+/// Whether polygon `i` at inverse depth `z` is nearer than `best` at `best_z`: larger `1/z`,
+/// and on a tie the lower index.
+#[inline]
+fn nearer((z, i): (f64, u32), (best_z, best): (f64, u32)) -> bool {
+    z > best_z || (z == best_z && i < best)
+}
+
 /// Per-band scratch and counters.
 struct Walk<'s> {
     scene: &'s Scene,
@@ -220,9 +226,8 @@ impl Walk<'_> {
         let mut best_z = self.planes[best as usize].inv_z(xc, self.yc);
         for &i in &set[1..] {
             let z = self.planes[i as usize].inv_z(xc, self.yc);
-            if z > best_z || (z == best_z && i < best) {
-                best = i;
-                best_z = z;
+            if nearer((z, i), (best_z, best)) {
+                (best, best_z) = (i, z);
             }
         }
         best
@@ -239,10 +244,10 @@ impl Walk<'_> {
         for &i in &set[1..] {
             let plane = &self.planes[i as usize];
             let (za, zb) = (plane.inv_z(xa, self.yc), plane.inv_z(xb, self.yc));
-            if za > left_z || (za == left_z && i < left) {
+            if nearer((za, i), (left_z, left)) {
                 (left, left_z) = (i, za);
             }
-            if zb > right_z || (zb == right_z && i < right) {
+            if nearer((zb, i), (right_z, right)) {
                 (right, right_z) = (i, zb);
             }
         }
