@@ -10,7 +10,7 @@ use crate::frame::{Frame, PixelCounters};
 use crate::progress::{Progress, ProgressFn, Reporter};
 use crate::reflection::ReflectionMethod;
 use crate::scene::Scene;
-use crate::shading::{RunShading, Shader};
+use crate::shading::{LineShading, Shader};
 use crate::shadow::{ShadowContext, ShadowDatabase, ShadowMethod};
 use crate::stats::{Counters, Stats};
 use crate::view::{Screen, View};
@@ -383,7 +383,7 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
     // Each sample's lit fraction along the line, sample by sample.
     let sample_count: usize = ctx.samples.iter().map(Vec::len).sum();
     let mut lit = vec![0.0f32; sample_count * w as usize];
-    let mut rs = RunShading::default();
+    let mut line_shading = LineShading::default();
     let (mut self_shadowed, mut walking, mut shading) = (0u64, Duration::ZERO, Duration::ZERO);
     for (y, runs) in (y0..y1).zip(&ctx.runs.lines[y0 as usize..y1 as usize]) {
         let row = ((y - y0) * w) as usize;
@@ -404,27 +404,23 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
         walking += t2 - t;
         // The frame comes in with last frame's pixels: every one is written here, the
         // runs' pixels by the runs and the rest as background.
-        let bg = ctx.scene.render.background;
         let mut gap = row;
         for run in runs {
             let (a, b) = (row + run.x0 as usize, row + run.x1 as usize);
-            clear(gap..a, bg, color, id, &mut light);
+            clear(gap..a, id, &mut light);
             id[a..b].fill(ctx.scene.polygons[run.poly as usize].face);
-            shader.begin_run(run, y, &mut rs);
             for (k, (l, s, _)) in ctx.all_samples().enumerate() {
-                let at = k * w as usize;
-                let lit = &lit[at + run.x0 as usize..at + run.x1 as usize];
+                let lit = &lit[k * w as usize + run.x0 as usize..][..b - a];
                 let share = 1.0 / ctx.samples[l].len() as f32;
                 // A light's first sample writes its lit fraction, the others add to it.
                 for (f, &v) in light[l][a..b].iter_mut().zip(lit) {
                     *f = if s == 0 { v * share } else { *f + v * share };
                 }
-                shader.add_light(&mut rs, l, s, lit);
             }
-            shader.finish_run(&rs, &mut color[a..b]);
             gap = b;
         }
-        clear(gap..row + w as usize, bg, color, id, &mut light);
+        clear(gap..row + w as usize, id, &mut light);
+        shader.shade_line(&mut line_shading, y, runs, &lit, &mut color[row..row + w as usize]);
         shading += t2.elapsed();
     }
     walker.finish(&mut shadow);
@@ -433,14 +429,7 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
 }
 
 /// Background pixels: no polygon, no light.
-fn clear(
-    pixels: std::ops::Range<usize>,
-    background: Vec3,
-    color: &mut [Vec3],
-    id: &mut [u32],
-    light: &mut [&mut [f32]],
-) {
-    color[pixels.clone()].fill(background);
+fn clear(pixels: std::ops::Range<usize>, id: &mut [u32], light: &mut [&mut [f32]]) {
     id[pixels.clone()].fill(crate::frame::BACKGROUND);
     for l in light {
         l[pixels.clone()].fill(0.0);

@@ -1,11 +1,17 @@
-//! The per-pixel part of Gouraud and Phong shading in eight f32 lanes: one run of pixels at a
-//! time, each value found from the pixel's position along the run rather than from the
-//! pixel's world point.
+//! The per-pixel part of shading in eight f32 lanes, a whole scanline at a time.
+//!
+//! A line is shaded in two steps. First each run writes what its pixels need into the
+//! line's arrays, one value per pixel, struct-of-arrays: its ambient term, the light of
+//! flat and Gouraud shading, and, for Phong shading, each pixel's point `q = p − eye`, its
+//! unit normal and its material. Then one pass over the line lights the Phong pixels
+//! eight at a time, whichever runs they belong to, so a line of short runs (a mesh of small
+//! triangles) fills its lanes as well as one long run does, and each pixel's geometry is
+//! loaded once for all light samples.
 //!
 //! Along a scanline, the ray through pixel `x0 + i` is `ray + i·step`, and the polygon's
-//! plane is met at `q = (ray + i·step) · depth / (den₀ + i·den₁)` (`q = p − eye`; `den` is
-//! the plane normal's dot product with the ray, so both are linear in `i`). The parameter
-//! `s` between the run's two edge crossings, by which [`super`] interpolates normals and
+//! plane is met at `q = (ray + i·step) · depth / (den₀ + i·den₁)` (`den` is the plane
+//! normal's dot product with the ray, so both are linear in `i`). The parameter `s`
+//! between the run's two edge crossings, by which [`super`] interpolates normals and
 //! colours, is the ratio of two such linear functions as well. So a pixel costs a handful
 //! of multiply-adds and one division for its geometry, whatever the polygon, and then
 //! Phong, Blinn or Cook-Torrance in lanes, with [`super::fast_pow`] for the powers.
@@ -26,19 +32,27 @@ const W: usize = 8;
 
 type V3 = [f32x8; 3];
 
-/// A run's pixels, eight to a lane group, struct-of-arrays.
+/// One line's pixels, struct-of-arrays, padded to whole lane groups.
 #[derive(Debug, Default)]
-pub(super) struct RunLanes {
-    len: usize,
-    /// `s` between the two edge crossings, in `[0, 1]` (Gouraud mode).
+pub(super) struct LineLanes {
+    /// Pixels in the line, and rounded up to whole groups.
+    width: usize,
+    padded: usize,
+    /// Phong pixels: `p − eye` and the unit normal turned toward the viewer.
+    q: [Vec<f32x8>; 3],
+    normal: [Vec<f32x8>; 3],
+    /// The line's Phong pixels as stretches of one material, in increasing x.
+    stretches: Vec<Stretch>,
+    /// The light gathered so far, starting from the ambient term.
+    acc: [Vec<f32x8>; 3],
+    /// Scratch: a Gouraud run's `s`, one value per pixel.
     s: Vec<f32x8>,
-    /// `p − eye`, the unit normal turned toward the viewer, and the unit vector to the eye
-    /// (Phong mode only).
-    q: Vec<V3>,
-    normal: Vec<V3>,
-    view: Vec<V3>,
-    /// The light gathered so far.
-    acc: Vec<V3>,
+    /// The Phong pass's constants for one material, one per light sample.
+    constants: Vec<PhongConstants>,
+    constants_for: u32,
+    /// The background colour, and the end of the last run started.
+    background: Vec3,
+    claimed: usize,
 }
 
 /// What a run's lanes are filled from: the f64 coefficients above, rounded to f32.
@@ -55,7 +69,7 @@ pub(super) struct RunGeometry {
     pub s_div: [f32; 2],
     /// For Phong shading: the normals at the two crossings, and the plane's (for a blend
     /// that cancels to zero), all turned toward the viewer.
-    pub normals: Option<[[f32; 3]; 3]>,
+    pub normals: [[f32; 3]; 3],
 }
 
 /// A light sample as the lanes see it.
@@ -108,12 +122,59 @@ fn normalize(v: V3, fallback: &V3) -> V3 {
     [0, 1, 2].map(|c| nonzero.select(v[c] * inv, fallback[c]))
 }
 
-/// The lit values of lane group `g` (zero past the run's end).
-fn load(lit: &[f32], g: usize) -> f32x8 {
-    let mut a = [0.0; W];
-    let from = &lit[W * g..lit.len().min(W * g + W)];
-    a[..from.len()].copy_from_slice(from);
-    f32x8::from(a)
+/// Eight values of `v` from `at` (zero past its end).
+#[inline(always)]
+fn load(v: &[f32], at: usize) -> f32x8 {
+    match v.get(at..at + W) {
+        Some(a) => f32x8::from(<[f32; W]>::try_from(a).unwrap_or_default()),
+        None => {
+            let mut a = [0.0; W];
+            let from = v.get(at..).unwrap_or_default();
+            a[..from.len()].copy_from_slice(from);
+            f32x8::from(a)
+        }
+    }
+}
+
+/// Eight pixels' values of a three-channel array, group `g`.
+#[inline(always)]
+fn load3(v: &[Vec<f32x8>; 3], g: usize) -> V3 {
+    [v[0][g], v[1][g], v[2][g]]
+}
+
+/// Groups of eight values as the values.
+fn flat(v: &[f32x8]) -> &[f32] {
+    wide::bytemuck::cast_slice(v)
+}
+
+fn flat_mut(v: &mut [f32x8]) -> &mut [f32] {
+    wide::bytemuck::cast_slice_mut(v)
+}
+
+/// Writes the first `n` of the eight values of `x` to `v` from `at`.
+#[inline(always)]
+fn store(v: &mut [f32], at: usize, n: usize, x: f32x8) {
+    let x = x.to_array();
+    if n == W {
+        v[at..at + W].copy_from_slice(&x);
+    } else {
+        for (v, x) in v[at..at + n].iter_mut().zip(x) {
+            *v = x;
+        }
+    }
+}
+
+/// The index `i` of each lane of group `g` along a run.
+fn index(g: usize) -> f32x8 {
+    f32x8::from([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]) + (W * g) as f32
+}
+
+/// `s` of the lanes at `i`, in `[0, 1]`.
+fn s_at(g: &RunGeometry, i: f32x8) -> f32x8 {
+    let s = i.mul_add(f32x8::splat(g.s_num[1]), f32x8::splat(g.s_num[0]))
+        / i.mul_add(f32x8::splat(g.s_div[1]), f32x8::splat(g.s_div[0]));
+    // Not-a-number (a zero divisor) fails the first test and becomes 0.
+    s.simd_ge(f32x8::ZERO).select(s, f32x8::ZERO).min(f32x8::ONE)
 }
 
 /// A channel that overflowed, to infinity or to not-a-number (infinity times zero, or less
@@ -123,101 +184,230 @@ fn finite(c: f32x8) -> f32x8 {
     c.is_nan().select(max, c.max(-max).min(max))
 }
 
-impl RunLanes {
-    /// Starts a run of `len` pixels with no light yet.
-    pub fn start(&mut self, len: usize) {
-        self.len = len;
-        self.acc.clear();
-        self.acc.resize(len.div_ceil(W), splat([0.0; 3]));
+impl LineLanes {
+    /// Starts a line of `width` pixels, every one the background until a run claims it.
+    pub fn start(&mut self, width: usize, background: Vec3) {
+        self.width = width;
+        self.padded = width.div_ceil(W) * W;
+        for v in self.acc.iter_mut().chain(&mut self.q).chain(&mut self.normal) {
+            v.resize(self.padded / W, f32x8::ZERO);
+        }
+        self.stretches.clear();
+        (self.background, self.claimed) = (background, 0);
     }
 
-    /// Writes `ambient` plus the light gathered to `out`, the run's pixels in the frame.
-    pub fn finish(&self, ambient: Vec3, out: &mut [Vec3]) {
-        let ambient = splat(ambient.to_array());
-        for (acc, out) in self.acc.iter().zip(out.chunks_mut(W)) {
-            let [r, g, b] = [0, 1, 2].map(|c| finite(acc[c] + ambient[c]).to_array());
-            for (j, o) in out.iter_mut().enumerate() {
+    /// Starts the run of pixels `x0..x1` (runs come in increasing x) with its ambient term;
+    /// the pixels since the last run are background.
+    pub fn start_run(&mut self, x0: usize, x1: usize, ambient: Vec3) {
+        self.background_to(x0);
+        for (c, v) in self.acc.iter_mut().enumerate() {
+            flat_mut(v)[x0..x1].fill(ambient[c]);
+        }
+        self.claimed = x1;
+    }
+
+    /// Makes the pixels from the last run's end to `x` background.
+    fn background_to(&mut self, x: usize) {
+        let from = self.claimed.min(x);
+        for (c, v) in self.acc.iter_mut().enumerate() {
+            flat_mut(v)[from..x].fill(self.background[c]);
+        }
+    }
+
+    /// Flat: adds one colour to the run at `x0`, weighted by `lit` (one value per pixel).
+    pub fn add_flat(&mut self, x0: usize, color: Vec3, lit: &[f32]) {
+        for (c, v) in self.acc.iter_mut().enumerate() {
+            for (a, &l) in flat_mut(v)[x0..x0 + lit.len()].iter_mut().zip(lit) {
+                *a = color[c].mul_add(l, *a);
+            }
+        }
+    }
+
+    /// Gouraud: readies the run of `len` pixels for [`LineLanes::add_gouraud`].
+    pub fn gouraud_run(&mut self, g: &RunGeometry, len: usize) {
+        self.s.clear();
+        self.s.extend((0..len.div_ceil(W)).map(|group| s_at(g, index(group))));
+    }
+
+    /// Gouraud: adds the colour interpolated between `left` and `right`, the colours at the
+    /// run's two edge crossings, to the run at `x0`, weighted by `lit`.
+    pub fn add_gouraud(&mut self, x0: usize, left: Vec3, right: Vec3, lit: &[f32]) {
+        let (l, d) = (splat(left.to_array()), splat((right - left).to_array()));
+        for (group, &s) in self.s.iter().enumerate() {
+            let (at, n) = (x0 + W * group, (lit.len() - W * group).min(W));
+            let v = load(lit, W * group);
+            for c in 0..3 {
+                let sum = s.mul_add(d[c], l[c]).mul_add(v, load(flat(&self.acc[c]), at));
+                store(flat_mut(&mut self.acc[c]), at, n, sum);
+            }
+        }
+    }
+
+    /// Adds light computed elsewhere (the f64 path) to the run at `x0`.
+    pub fn add(&mut self, x0: usize, light: &[Vec3]) {
+        for (c, v) in self.acc.iter_mut().enumerate() {
+            for (a, l) in flat_mut(v)[x0..x0 + light.len()].iter_mut().zip(light) {
+                *a += l[c];
+            }
+        }
+    }
+
+    /// Phong: writes the point and normal of each of the run's `len` pixels from `x0`, for
+    /// [`LineLanes::shade_phong`] to light with `material`.
+    pub fn phong_run(&mut self, x0: usize, len: usize, g: &RunGeometry, material: u32) {
+        let [left, right, plane] = g.normals;
+        let (ray, step) = (splat(g.ray), splat(g.step));
+        let (depth, den) = (f32x8::splat(g.depth), g.den.map(f32x8::splat));
+        let (left, slope) = (splat(left), splat([0, 1, 2].map(|c| right[c] - left[c])));
+        let plane = splat(plane);
+        for group in 0..len.div_ceil(W) {
+            let (i, at, n) = (index(group), x0 + W * group, (len - W * group).min(W));
+            let s = s_at(g, i);
+            let t = depth / i.mul_add(den[1], den[0]);
+            let normal = normalize([0, 1, 2].map(|c| s.mul_add(slope[c], left[c])), &plane);
+            for c in 0..3 {
+                store(flat_mut(&mut self.q[c]), at, n, i.mul_add(step[c], ray[c]) * t);
+                store(flat_mut(&mut self.normal[c]), at, n, normal[c]);
+            }
+        }
+        match self.stretches.last_mut() {
+            Some(last) if last.material == material && last.x1 == x0 => last.x1 += len,
+            _ => self.stretches.push(Stretch { material, x0, x1: x0 + len }),
+        }
+    }
+
+    /// Phong: lights every Phong pixel of the line with every light sample, sample `k`'s
+    /// lit values being `lit[k * width..][..width]`, a stretch of one material at a time,
+    /// eight pixels at a time. Ends the line's runs.
+    pub fn shade_phong(&mut self, lights: &[LaneLight], materials: &[LaneMaterial], lit: &[f32]) {
+        self.background_to(self.padded);
+        let LineLanes { width, q, normal, acc, stretches, constants, constants_for, .. } = self;
+        let rows = Rows { lit, width: *width };
+        for &Stretch { material: m, x0, x1 } in stretches.iter() {
+            let k = constants_of(constants, constants_for, m, lights, materials);
+            let material = &materials[m as usize];
+            for at in (x0 / W * W..x1).step_by(W) {
+                // A group the stretch does not fill is shared with its neighbours' pixels.
+                let mask = (at < x0 || at + W > x1).then(|| {
+                    let x = index(0) + at as f32;
+                    x.simd_ge(f32x8::splat(x0 as f32)) & x.simd_lt(f32x8::splat(x1 as f32))
+                });
+                let g = at / W;
+                let pixels = Pixels::new(load3(q, g), load3(normal, g), at);
+                let mut sum = load3(acc, g);
+                pixels.add(k, material, &rows, mask, &mut sum);
+                (acc[0][g], acc[1][g], acc[2][g]) = (sum[0], sum[1], sum[2]);
+            }
+        }
+    }
+
+    /// Writes the line to `out`: the ambient term and the light gathered, kept finite.
+    pub fn finish(&self, out: &mut [Vec3]) {
+        let colors = |group: usize| {
+            let [r, g, b] = load3(&self.acc, group);
+            [finite(r).to_array(), finite(g).to_array(), finite(b).to_array()]
+        };
+        let mut whole = out.chunks_exact_mut(W);
+        for (group, out) in whole.by_ref().enumerate() {
+            let [r, g, b] = colors(group);
+            for j in 0..W {
+                out[j] = Vec3::new(r[j], g[j], b[j]);
+            }
+        }
+        let rest = whole.into_remainder();
+        if !rest.is_empty() {
+            let [r, g, b] = colors(self.width / W);
+            for (j, o) in rest.iter_mut().enumerate() {
                 *o = Vec3::new(r[j], g[j], b[j]);
             }
         }
     }
+}
 
-    /// Flat: adds one colour, weighted by `lit`.
-    pub fn add_flat(&mut self, color: Vec3, lit: &[f32]) {
-        let c = splat(color.to_array());
-        for (g, acc) in self.acc.iter_mut().enumerate() {
-            let v = load(lit, g);
-            for k in 0..3 {
-                acc[k] = c[k].mul_add(v, acc[k]);
-            }
-        }
+/// Pixels `x0..x1` of a line, Phong-shaded with one material.
+#[derive(Debug, Clone, Copy)]
+struct Stretch {
+    material: u32,
+    x0: usize,
+    x1: usize,
+}
+
+/// The lit rows of a line's light samples.
+struct Rows<'a> {
+    lit: &'a [f32],
+    width: usize,
+}
+
+impl Rows<'_> {
+    /// Sample `k`'s lit values at eight pixels from `at` (zero past the line's end).
+    #[inline(always)]
+    fn at(&self, k: usize, at: usize) -> f32x8 {
+        load(&self.lit[k * self.width..(k + 1) * self.width], at)
+    }
+}
+
+/// Eight pixels' geometry: `p − eye`, the unit normal, the unit vector to the eye.
+struct Pixels {
+    q: V3,
+    n: V3,
+    view: V3,
+    at: usize,
+}
+
+impl Pixels {
+    #[inline(always)]
+    fn new(q: V3, n: V3, at: usize) -> Self {
+        let view = normalize([-q[0], -q[1], -q[2]], &splat([0.0; 3]));
+        Pixels { q, n, view, at }
     }
 
-    /// Fills the lanes for a run of `len` pixels.
-    pub fn fill(&mut self, g: &RunGeometry, len: usize) {
-        self.start(len);
-        self.s.clear();
-        self.q.clear();
-        self.normal.clear();
-        self.view.clear();
-        let first = f32x8::from([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
-        for group in 0..len.div_ceil(W) {
-            let i = first + (W * group) as f32;
-            let s = i.mul_add(f32x8::splat(g.s_num[1]), f32x8::splat(g.s_num[0]))
-                / i.mul_add(f32x8::splat(g.s_div[1]), f32x8::splat(g.s_div[0]));
-            // Not-a-number (a zero divisor) fails the first test and becomes 0.
-            let s = s.simd_ge(f32x8::ZERO).select(s, f32x8::ZERO).min(f32x8::ONE);
-            // Gouraud keeps `s`; Phong keeps what it interpolates with it.
-            let Some([left, right, plane]) = g.normals else {
-                self.s.push(s);
-                continue;
-            };
-            let t = f32x8::splat(g.depth) / i.mul_add(f32x8::splat(g.den[1]), f32x8::splat(g.den[0]));
-            let q = [0, 1, 2].map(|c| i.mul_add(f32x8::splat(g.step[c]), f32x8::splat(g.ray[c])) * t);
-            let n = [0, 1, 2].map(|c| s.mul_add(f32x8::splat(right[c] - left[c]), f32x8::splat(left[c])));
-            self.view.push(normalize(q.map(|v| -v), &splat([0.0; 3])));
-            self.normal.push(normalize(n, &splat(plane)));
-            self.q.push(q);
-        }
-    }
-
-    /// Gouraud: adds the colour interpolated between `left` and `right`, the colours at the
-    /// run's two edge crossings, weighted by `lit`.
-    pub fn add_gouraud(&mut self, left: Vec3, right: Vec3, lit: &[f32]) {
-        let (l, d) = (splat(left.to_array()), splat((right - left).to_array()));
-        for (g, (&s, acc)) in self.s.iter().zip(&mut self.acc).enumerate() {
-            let v = load(lit, g);
-            for c in 0..3 {
-                acc[c] = s.mul_add(d[c], l[c]).mul_add(v, acc[c]);
-            }
-        }
-    }
-
-    /// Phong: adds one light sample's light at every pixel, weighted by `lit`; the same
-    /// formulas as [`super::incident`] and [`super::reflect`].
-    pub fn add_phong(&mut self, light: &LaneLight, m: &LaneMaterial, lit: &[f32]) {
-        // Every constant in lanes once, before the loop.
-        let k = PhongConstants::new(light, m);
-        for g in 0..self.q.len() {
-            let v = load(lit, g);
+    /// Adds every light sample's light to `sum`, in the lanes of `mask` (all when `None`).
+    #[inline(always)]
+    fn add(&self, constants: &[PhongConstants], m: &LaneMaterial, rows: &Rows, mask: Option<f32x8>, sum: &mut V3) {
+        for (k, constants) in constants.iter().enumerate() {
+            let v = rows.at(k, self.at);
             if v == f32x8::ZERO {
                 continue;
             }
-            let (n, eye) = (&self.normal[g], &self.view[g]);
-            let (l, att) = incident(&k, &self.q[g]);
-            let nl = dot(n, &l);
-            let spec = specular(m, &k, n, eye, &l, nl);
-            let weight = nl.simd_gt(f32x8::ZERO).select(att * spot(&k, &l) * v, f32x8::ZERO);
-            for ((acc, ks), kd) in self.acc[g].iter_mut().zip(&k.specular).zip(&k.diffuse) {
-                *acc = ks.mul_add(spec, *kd * nl).mul_add(weight, *acc);
+            let light = phong(constants, m, &self.q, &self.n, &self.view, v);
+            for c in 0..3 {
+                sum[c] += mask.map_or(light[c], |mask| mask.select(light[c], f32x8::ZERO));
             }
         }
-        debug_assert!(self.q.len() * W >= self.len);
     }
+}
+
+/// The Phong pass's constants for material `m`, one per light sample: those kept in
+/// `constants` if they are `m`'s (`kept_for`), else made anew.
+fn constants_of<'c>(
+    constants: &'c mut Vec<PhongConstants>,
+    kept_for: &mut u32,
+    m: u32,
+    lights: &[LaneLight],
+    materials: &[LaneMaterial],
+) -> &'c [PhongConstants] {
+    if *kept_for != m || constants.len() != lights.len() {
+        constants.clear();
+        constants.extend(lights.iter().map(|l| PhongConstants::new(l, &materials[m as usize])));
+        *kept_for = m;
+    }
+    constants
+}
+
+/// One light sample's light at eight pixels weighted by `lit`; the same formulas as
+/// [`super::incident`] and [`super::reflect`].
+#[inline(always)]
+fn phong(k: &PhongConstants, m: &LaneMaterial, q: &V3, n: &V3, view: &V3, lit: f32x8) -> V3 {
+    let (l, att) = incident(k, q);
+    let nl = dot(n, &l);
+    let spec = specular(m, k, n, view, &l, nl);
+    let weight = nl.simd_gt(f32x8::ZERO).select(att * spot(k, &l) * lit, f32x8::ZERO);
+    [0, 1, 2].map(|c| k.specular[c].mul_add(spec, k.diffuse[c] * nl) * weight)
 }
 
 /// A light sample and a material's numbers in lanes; the light's radiance is folded into
 /// the material's `kd Od` and `ks Os`.
+#[derive(Debug)]
 struct PhongConstants {
     point: Option<V3>,
     direction: V3,

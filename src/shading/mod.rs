@@ -36,21 +36,22 @@
 //!
 //! Two paths compute this. The formulas below, [`incident`] and [`reflect`], are the
 //! reference, in f64, point by point. The frame's runs go, wherever they can, through
-//! the `lanes` module: eight pixels at a time in f32, each pixel's point and interpolation parameter
-//! found from its place along the run (one division each), and powers through
+//! the `lanes` module: a line at a time, eight pixels at a time in f32, each pixel's point
+//! and interpolation parameter found from its place along its run (one division each),
+//! the Phong pixels of all the line's runs lit together in full lanes, and powers through
 //! `fast_pow`, whose error bound is stated and tested there. A run stays on the f64 path
 //! when its line crosses the polygon's outline more than twice (a concave polygon), when
-//! its points are too far from the eye for single precision (`LANE_REACH`), or, for one
-//! light sample, when that sample is too close to the polygon's plane for its direction to
-//! be found in single precision (`LANE_RATIO`). A test holds the two paths to each other
-//! on every run of random scenes.
+//! its points are too far from the eye for single precision (`LANE_REACH`), or, in Phong
+//! mode, when a light sample is too close to the polygon's plane for its direction to be
+//! found in single precision (`LANE_RATIO`). A test holds the two paths to each other on
+//! every pixel of random scenes.
 
 use crate::geometry::centroid;
 use crate::scene::{Light, LightKind, LightSample, Material, Scene, ShadingMode, SpecularModel};
 use crate::view::View;
 use crate::visibility::Run;
 use glam::{DVec3, Vec3};
-use lanes::{LaneLight, LaneMaterial, RunGeometry, RunLanes, Toward};
+use lanes::{LaneLight, LaneMaterial, LineLanes, RunGeometry, Toward};
 
 mod fast_pow;
 mod lanes;
@@ -125,48 +126,56 @@ fn specular(m: &Material, n: DVec3, v: DVec3, l: DVec3, nl: f64) -> f64 {
     }
 }
 
-/// Shades runs of a scene seen from a view.
+/// Shades the runs of a scene seen from a view, a line at a time.
 pub(crate) struct Shader<'a> {
     scene: &'a Scene,
     view: &'a View,
     samples: &'a [Vec<LightSample>],
-    /// Each light sample as the lane kernels see it, with its position for point samples.
-    lane_lights: Vec<Vec<(LaneLight, Option<PointAt>)>>,
+    /// Every light sample as the lane kernels see it, in the order of the lit rows, with
+    /// its position for point samples.
+    lane_lights: Vec<LaneLight>,
+    positions: Vec<Option<PointAt>>,
     /// Each material as the lane kernels see it.
     lane_materials: Vec<LaneMaterial>,
 }
 
+/// Scratch for shading lines, kept from line to line (one per band of lines).
+#[derive(Debug, Default)]
+pub(crate) struct LineShading {
+    lanes: LineLanes,
+    run: RunShading,
+    /// Every run on the f64 path (the tests compare the two paths with it).
+    f64_only: bool,
+    /// Gouraud and Phong runs shaded in lanes and in f64.
+    runs_in_lanes: u64,
+    runs_in_f64: u64,
+}
+
 /// Per-run scratch: what one run needs whatever the light (reused from run to run).
 #[derive(Debug, Default)]
-pub(crate) struct RunShading {
+struct RunShading {
     poly: usize,
-    mode: ShadingMode,
     /// +1 or -1: turns the polygon's normals toward the viewer.
     flip: f64,
-    centroid: DVec3,
-    /// The run's first pixel, its length, and its line's centre.
+    /// The run's first pixel and its length, its line's centre, the normal of the line's
+    /// scan plane, and the ray through the line's first pixel centre.
     x0: u32,
     len: u32,
     yc: f64,
+    scan_normal: DVec3,
+    ray_row: DVec3,
     /// The scan plane's crossings with the polygon's edges, sorted along `along`, the line
     /// where the polygon meets the scan plane.
     crossings: Vec<ScanCrossing>,
     along: DVec3,
-    /// Whether the run is in `lanes` (see [`lanes`]), and the larger `|p - eye|` of its ends.
-    in_lanes: bool,
+    /// The larger `|p - eye|` of the run's ends (for runs in lanes).
     reach: f64,
-    lanes: RunLanes,
-    /// The f64 path, filled for the runs and lights the lanes do not take, and the light
-    /// it added (`f64_lit`: whether it added any to this run).
-    f64_ready: bool,
-    f64_light: Vec<Vec3>,
-    f64_lit: bool,
-    /// World point seen at each pixel (Gouraud and Phong modes).
+    /// The f64 path: world point seen at each pixel, its value as weights of up to four of
+    /// the polygon's vertices, the interpolated unit normal (Phong mode), and the light.
     points: Vec<DVec3>,
-    /// Each pixel's value as weights of up to four of the polygon's vertices.
     weights: Vec<[(u32, f64); 4]>,
-    /// Interpolated unit normal at each pixel (Phong mode).
     normals: Vec<DVec3>,
+    light: Vec<Vec3>,
     /// Scratch: one value per polygon vertex (Gouraud mode).
     vertex_colors: Vec<Vec3>,
 }
@@ -187,22 +196,23 @@ type PointAt = (DVec3, f64);
 /// lengths stay far inside single precision.
 const LANE_REACH: f64 = 1e15;
 
-/// ... and a point light sample only where it is at least 1/`LANE_RATIO` as far from the
-/// polygon's plane as it and the run's points are from the eye: the vector from a pixel to
-/// the light is then found to a relative error below about `LANE_RATIO · 2⁻²³`, 1.2·10⁻⁴.
+/// ... and, in Phong mode, only where every point light sample is at least
+/// 1/`LANE_RATIO` as far from the polygon's plane as it and the run's points are from the
+/// eye: the vector from a pixel to the light is then found to a relative error below about
+/// `LANE_RATIO · 2⁻²³`, 1.2·10⁻⁴.
 const LANE_RATIO: f64 = 1000.0;
 
 impl<'a> Shader<'a> {
     /// A shader for `scene` from `view`, with each light's samples.
     pub fn new(scene: &'a Scene, view: &'a View, samples: &'a [Vec<LightSample>]) -> Self {
-        let lane_lights = scene
+        let (lane_lights, positions) = scene
             .lights
             .iter()
             .zip(samples)
-            .map(|(light, samples)| samples.iter().map(|s| lane_light(light, s, samples.len(), view.eye)).collect())
-            .collect();
+            .flat_map(|(light, samples)| samples.iter().map(|s| lane_light(light, s, samples.len(), view.eye)))
+            .unzip();
         let lane_materials = scene.materials.iter().map(lane_material).collect();
-        Shader { scene, view, samples, lane_lights, lane_materials }
+        Shader { scene, view, samples, lane_lights, positions, lane_materials }
     }
 
     /// The ambient term `Ia ka Od` of polygon `poly`.
@@ -211,62 +221,178 @@ impl<'a> Shader<'a> {
         self.scene.render.ambient * m.ka * m.color
     }
 
-    /// Prepares `rs` for `run` on line `line`: where the polygon's outline crosses the line
-    /// and, for Gouraud and Phong shading, each pixel's place between those crossings (in
-    /// lanes, or in f64 when the run is not one for lanes).
-    pub fn begin_run(&self, run: &Run, line: u32, rs: &mut RunShading) {
+    /// Shades line `line`: its `runs` (in increasing x) from the lit values the shadow
+    /// stage left, sample `k`'s at `lit[k * width + x]`, and the background between them,
+    /// into `out`, the line's pixels.
+    pub fn shade_line(&self, ls: &mut LineShading, line: u32, runs: &[Run], lit: &[f32], out: &mut [Vec3]) {
+        let width = self.view.width as usize;
+        ls.lanes.start(width, self.scene.render.background);
+        let rs = &mut ls.run;
+        rs.yc = line as f64 + 0.5;
+        // The scan plane holds the eye and every ray of this scanline.
+        rs.scan_normal = self.view.ray(0.0, rs.yc).cross(self.view.r);
+        rs.ray_row = self.view.ray(0.5, rs.yc);
+        for run in runs {
+            let (x0, x1) = (run.x0 as usize, run.x1 as usize);
+            let lit = |k: usize| &lit[k * width + x0..k * width + x1];
+            self.begin_run(run, rs);
+            ls.lanes.start_run(x0, x1, self.ambient(rs.poly));
+            let in_lanes = match self.scene.material(rs.poly).shading {
+                ShadingMode::Flat => {
+                    self.flat_run(rs, &mut ls.lanes, lit);
+                    continue;
+                }
+                ShadingMode::Gouraud => self.gouraud_run(rs, &mut ls.lanes, ls.f64_only, lit),
+                ShadingMode::Phong => self.phong_run(rs, &mut ls.lanes, ls.f64_only, lit),
+            };
+            *(if in_lanes { &mut ls.runs_in_lanes } else { &mut ls.runs_in_f64 }) += 1;
+        }
+        ls.lanes.shade_phong(&self.lane_lights, &self.lane_materials, lit);
+        ls.lanes.finish(out);
+    }
+
+    /// Every light sample: its light, sample index, and flat index (its row of lit values).
+    fn samples(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        let per_light = self.samples.iter().enumerate().flat_map(|(l, s)| (0..s.len()).map(move |s| (l, s)));
+        per_light.enumerate().map(|(k, (l, s))| (l, s, k))
+    }
+
+    /// Readies `rs` for `run`, on the line `rs` was readied for.
+    fn begin_run(&self, run: &Run, rs: &mut RunShading) {
         let poly = run.poly as usize;
         let plane = &self.scene.polygons[poly].plane;
         rs.poly = poly;
-        rs.mode = self.scene.material(poly).shading;
         rs.flip = if plane.distance(self.view.eye) >= 0.0 { 1.0 } else { -1.0 };
-        (rs.x0, rs.len, rs.yc) = (run.x0, run.x1 - run.x0, line as f64 + 0.5);
-        (rs.in_lanes, rs.f64_ready, rs.f64_lit) = (false, false, false);
-        rs.lanes.start(rs.len as usize);
-        if rs.mode == ShadingMode::Flat {
-            rs.centroid = centroid(self.scene.verts(poly));
-            return;
+        (rs.x0, rs.len) = (run.x0, run.x1 - run.x0);
+    }
+
+    /// The light at a world point `p` with unit normal `n` (turned toward the viewer), of
+    /// sample `s` of light `l`, in f64.
+    fn shade(&self, poly: usize, l: usize, s: usize, p: DVec3, n: DVec3) -> Vec3 {
+        let (light, samples) = (&self.scene.lights[l], &self.samples[l]);
+        let (to_light, radiance) = incident(light, &samples[s], samples.len(), p);
+        radiance * reflect(self.scene.material(poly), n, (self.view.eye - p).normalize(), to_light)
+    }
+
+    /// Flat: one colour per sample, lit at the polygon's centroid with its plane normal.
+    fn flat_run<'l>(&self, rs: &RunShading, lanes: &mut LineLanes, lit: impl Fn(usize) -> &'l [f32]) {
+        let centroid = centroid(self.scene.verts(rs.poly));
+        let n = self.scene.polygons[rs.poly].plane.n * rs.flip;
+        for (l, s, k) in self.samples() {
+            lanes.add_flat(rs.x0 as usize, self.shade(rs.poly, l, s, centroid, n), lit(k));
         }
+    }
+
+    /// Gouraud: colours lit at the vertices, interpolated to the two crossings and along the
+    /// run (in lanes when it can; else in f64). Returns whether it was in lanes.
+    fn gouraud_run<'l>(
+        &self,
+        rs: &mut RunShading,
+        lanes: &mut LineLanes,
+        f64_only: bool,
+        lit: impl Fn(usize) -> &'l [f32],
+    ) -> bool {
         self.scan_crossings(rs);
-        rs.in_lanes = rs.crossings.len() == 2 && self.fill_lanes(rs);
-        if !rs.in_lanes {
-            self.prepare_f64(rs);
+        let geometry = if f64_only { None } else { self.lane_geometry(rs, false) };
+        if let Some(g) = &geometry {
+            lanes.gouraud_run(g, rs.len as usize);
+        } else {
+            self.prepare_f64(rs, false);
         }
+        let verts = self.scene.verts(rs.poly);
+        let vn = self.scene.vertex_normals(rs.poly);
+        for (l, s, k) in self.samples() {
+            rs.vertex_colors.clear();
+            rs.vertex_colors.extend(verts.iter().zip(vn).map(|(&p, &n)| self.shade(rs.poly, l, s, p, n * rs.flip)));
+            if geometry.is_some() {
+                let at = |c: ScanCrossing| crossing_value(&rs.vertex_colors, c, |v| v.as_dvec3()).as_vec3();
+                lanes.add_gouraud(rs.x0 as usize, at(rs.crossings[0]), at(rs.crossings[1]), lit(k));
+                continue;
+            }
+            let (weights, colors) = (&rs.weights, &rs.vertex_colors);
+            rs.light.clear();
+            rs.light.extend(weights.iter().zip(lit(k)).map(|(w, &v)| {
+                let c: Vec3 =
+                    if v == 0.0 { Vec3::ZERO } else { w.iter().map(|&(k, a)| colors[k as usize] * a as f32).sum() };
+                c * v
+            }));
+            lanes.add(rs.x0 as usize, &rs.light);
+        }
+        geometry.is_some()
+    }
+
+    /// Phong: normals interpolated and renormalised, lit per pixel: in lanes when the run
+    /// and every light sample allow it (the lit pass of [`LineLanes::shade_phong`] then
+    /// lights it with the rest of the line); else here, in f64. Returns whether it was in
+    /// lanes.
+    fn phong_run<'l>(
+        &self,
+        rs: &mut RunShading,
+        lanes: &mut LineLanes,
+        f64_only: bool,
+        lit: impl Fn(usize) -> &'l [f32],
+    ) -> bool {
+        self.scan_crossings(rs);
+        let geometry = if f64_only { None } else { self.lane_geometry(rs, true) };
+        if let Some(g) = geometry.filter(|_| self.lights_fit_lanes(rs)) {
+            let material = self.scene.objects[self.scene.polygons[rs.poly].object as usize].material;
+            lanes.phong_run(rs.x0 as usize, rs.len as usize, &g, material as u32);
+            return true;
+        }
+        self.prepare_f64(rs, true);
+        for (l, s, k) in self.samples() {
+            let (points, normals) = (&rs.points, &rs.normals);
+            rs.light.clear();
+            rs.light.extend(lit(k).iter().enumerate().map(|(i, &v)| {
+                if v == 0.0 {
+                    Vec3::ZERO
+                } else {
+                    self.shade(rs.poly, l, s, points[i], normals[i]) * v
+                }
+            }));
+            lanes.add(rs.x0 as usize, &rs.light);
+        }
+        false
     }
 
     /// Fills `rs.crossings` and `rs.along`.
     fn scan_crossings(&self, rs: &mut RunShading) {
         let verts = self.scene.verts(rs.poly);
         let plane = &self.scene.polygons[rs.poly].plane;
-        let eye = self.view.eye;
-        // The scan plane holds the eye and every ray of this scanline.
-        let ns = self.view.ray(0.0, rs.yc).cross(self.view.r);
+        let (eye, ns) = (self.view.eye, rs.scan_normal);
         rs.along = plane.n.cross(ns);
         rs.crossings.clear();
         // Each edge k -> k+1, the last one closing the ring (no division for the wrap).
-        for (k, (&a, &b)) in verts.iter().zip(verts[1..].iter().chain(&verts[..1])).enumerate() {
-            let (da, db) = (ns.dot(a - eye), ns.dot(b - eye));
+        let mut a = verts[verts.len() - 1];
+        let mut da = ns.dot(a - eye);
+        for (k, &b) in verts.iter().enumerate() {
+            let db = ns.dot(b - eye);
             if (da >= 0.0) != (db >= 0.0) {
                 let t = da / (da - db);
                 let c = a + (b - a) * t;
+                let k = if k == 0 { verts.len() - 1 } else { k - 1 };
                 rs.crossings.push(ScanCrossing { u: (c - eye).dot(rs.along), k: k as u32, t });
             }
+            (a, da) = (b, db);
         }
         rs.crossings.sort_unstable_by(|a, b| a.u.total_cmp(&b.u));
     }
 
-    /// Fills the lanes of a run whose line crosses the outline twice, if its points fit
-    /// single precision ([`LANE_REACH`]); returns whether it did.
-    fn fill_lanes(&self, rs: &mut RunShading) -> bool {
+    /// The lanes' coefficients for a run whose line crosses the outline twice, if its points
+    /// fit single precision ([`LANE_REACH`]); with the normals at the crossings for Phong.
+    fn lane_geometry(&self, rs: &mut RunShading, phong: bool) -> Option<RunGeometry> {
+        if rs.crossings.len() != 2 {
+            return None;
+        }
         let plane = &self.scene.polygons[rs.poly].plane;
-        let ray = self.view.ray(rs.x0 as f64 + 0.5, rs.yc);
         let step = self.view.ray_step();
+        let ray = rs.ray_row + step * rs.x0 as f64;
         let depth = -plane.distance(self.view.eye);
         let den = [plane.n.dot(ray), plane.n.dot(step)];
         let reach2 = |i: f64| ((ray + step * i) * (depth / (den[0] + i * den[1]))).length_squared();
         rs.reach = reach2(0.0).max(reach2((rs.len - 1) as f64)).sqrt();
         if rs.reach.is_nan() || rs.reach >= LANE_REACH {
-            return false;
+            return None;
         }
         let (l, r) = (rs.crossings[0], rs.crossings[1]);
         // s = (u - u_l) / (u_r - u_l), with u = depth (ray_i . along) / den_i.
@@ -277,13 +403,15 @@ impl<'a> Shader<'a> {
         } else {
             ([0.5, 0.0], [1.0, 0.0])
         };
-        let normals = (rs.mode == ShadingMode::Phong).then(|| {
+        let normals = if phong {
             let vn = self.scene.vertex_normals(rs.poly);
             let at = |c: ScanCrossing| crossing_value(vn, c, |v| *v) * rs.flip;
             [at(l), at(r), plane.n * rs.flip].map(|v| v.as_vec3().to_array())
-        });
+        } else {
+            [[0.0; 3]; 3]
+        };
         let f32s = |v: [f64; 2]| v.map(|x| x as f32);
-        let g = RunGeometry {
+        Some(RunGeometry {
             ray: ray.as_vec3().to_array(),
             step: step.as_vec3().to_array(),
             depth: depth as f32,
@@ -291,19 +419,27 @@ impl<'a> Shader<'a> {
             s_num: f32s(s_num),
             s_div: f32s(s_div),
             normals,
-        };
-        rs.lanes.fill(&g, rs.len as usize);
-        true
+        })
+    }
+
+    /// Whether every point light sample is far enough from the run's plane for the lanes
+    /// ([`LANE_RATIO`]).
+    fn lights_fit_lanes(&self, rs: &RunShading) -> bool {
+        let plane = &self.scene.polygons[rs.poly].plane;
+        self.positions.iter().flatten().all(|(p, from_eye)| {
+            let far = from_eye + rs.reach;
+            far < LANE_REACH && far < LANE_RATIO * plane.distance(*p).abs()
+        })
     }
 
     /// The f64 path's points, weights and (Phong mode) normals.
-    fn prepare_f64(&self, rs: &mut RunShading) {
+    fn prepare_f64(&self, rs: &mut RunShading, phong: bool) {
         let plane = &self.scene.polygons[rs.poly].plane;
         rs.points.clear();
         let (x0, yc) = (rs.x0, rs.yc);
         rs.points.extend((x0..x0 + rs.len).map(|x| self.view.point_on(plane, x as f64 + 0.5, yc)));
         self.interpolation_weights(rs);
-        if rs.mode == ShadingMode::Phong {
+        if phong {
             let vn = self.scene.vertex_normals(rs.poly);
             rs.normals.clear();
             rs.normals.extend(rs.weights.iter().map(|w| {
@@ -311,7 +447,6 @@ impl<'a> Shader<'a> {
                 (n * rs.flip).normalize_or(plane.n * rs.flip)
             }));
         }
-        rs.f64_ready = true;
     }
 
     /// Fills `rs.weights`: each pixel's point as a blend of the two edge crossings of the scan
@@ -348,99 +483,6 @@ impl<'a> Shader<'a> {
                 ]
             };
             rs.weights.push(w);
-        }
-    }
-
-    /// Adds the light of sample `sample` of light `light` to the run prepared in `rs`,
-    /// pixel `i` weighted by its lit value `lit[i]`.
-    pub fn add_light(&self, rs: &mut RunShading, light: usize, sample: usize, lit: &[f32]) {
-        let l = &self.scene.lights[light];
-        let s = &self.samples[light][sample];
-        let ns = self.samples[light].len();
-        let m = self.scene.material(rs.poly);
-        let eye = self.view.eye;
-        let shade = |p: DVec3, n: DVec3| {
-            let (to_light, radiance) = incident(l, s, ns, p);
-            radiance * reflect(m, n, (eye - p).normalize(), to_light)
-        };
-        match rs.mode {
-            ShadingMode::Flat => {
-                let n = self.scene.polygons[rs.poly].plane.n * rs.flip;
-                rs.lanes.add_flat(shade(rs.centroid, n), lit);
-            }
-            ShadingMode::Gouraud => {
-                let verts = self.scene.verts(rs.poly);
-                let vn = self.scene.vertex_normals(rs.poly);
-                rs.vertex_colors.clear();
-                rs.vertex_colors.extend(verts.iter().zip(vn).map(|(&p, &n)| shade(p, n * rs.flip)));
-                if rs.in_lanes {
-                    let at = |c: ScanCrossing| crossing_value(&rs.vertex_colors, c, |v| v.as_dvec3()).as_vec3();
-                    let (left, right) = (at(rs.crossings[0]), at(rs.crossings[1]));
-                    rs.lanes.add_gouraud(left, right, lit);
-                    return;
-                }
-                let (weights, colors) = (&rs.weights, &rs.vertex_colors);
-                add_f64(&mut rs.f64_light, &mut rs.f64_lit, lit, |i| {
-                    weights[i].iter().map(|&(k, a)| colors[k as usize] * a as f32).sum()
-                });
-            }
-            ShadingMode::Phong => {
-                if let Some(ll) = self.lane_light_for(rs, light, sample) {
-                    rs.lanes.add_phong(
-                        ll,
-                        &self.lane_materials[self.scene.objects[self.scene.polygons[rs.poly].object as usize].material],
-                        lit,
-                    );
-                    return;
-                }
-                if !rs.f64_ready {
-                    self.prepare_f64(rs);
-                }
-                let (points, normals) = (&rs.points, &rs.normals);
-                add_f64(&mut rs.f64_light, &mut rs.f64_lit, lit, |i| shade(points[i], normals[i]));
-            }
-        }
-    }
-
-    /// Writes the run's pixels to `out`: the ambient term and the light its samples added,
-    /// kept finite.
-    pub fn finish_run(&self, rs: &RunShading, out: &mut [Vec3]) {
-        rs.lanes.finish(self.ambient(rs.poly), out);
-        if rs.f64_lit {
-            for (o, l) in out.iter_mut().zip(&rs.f64_light) {
-                *o = finite(*o + *l);
-            }
-        }
-    }
-
-    /// The lanes' view of a light sample, if the run is in lanes and the sample is one the
-    /// lanes can take for it ([`LANE_RATIO`]).
-    fn lane_light_for(&self, rs: &RunShading, light: usize, sample: usize) -> Option<&LaneLight> {
-        let (ll, position) = self.lane_lights[light].get(sample)?;
-        let ok = rs.in_lanes
-            && match position {
-                None => true,
-                Some((p, from_eye)) => {
-                    let plane = &self.scene.polygons[rs.poly].plane;
-                    let far = from_eye + rs.reach;
-                    far < LANE_REACH && far < LANE_RATIO * plane.distance(*p).abs()
-                }
-            };
-        ok.then_some(ll)
-    }
-}
-
-/// Adds `color(i) * lit[i]` to the f64 path's light, `light`, for every lit pixel `i`
-/// (zeroing `light` first if this run had none there yet).
-fn add_f64(light: &mut Vec<Vec3>, used: &mut bool, lit: &[f32], color: impl Fn(usize) -> Vec3) {
-    if !*used {
-        light.clear();
-        light.resize(lit.len(), Vec3::ZERO);
-        *used = true;
-    }
-    for (i, (o, &v)) in light.iter_mut().zip(lit).enumerate() {
-        if v != 0.0 {
-            *o += color(i) * v;
         }
     }
 }
@@ -491,8 +533,9 @@ fn lane_material(m: &Material) -> LaneMaterial {
 mod tests {
     use super::*;
 
-    /// Every run of random scenes (convex and star-shaped polygons, point, spot, directional
-    /// and area lights), shaded by the lanes and by the f64 path.
+    /// Every line of random scenes (convex and star-shaped polygons, point, spot,
+    /// directional and area lights, every shading mode and specular model), shaded with
+    /// the lanes and on the f64 path alone: every pixel agrees.
     #[test]
     fn lanes_agree_with_the_f64_path_on_random_scenes() {
         use crate::generate::{random, RandomOptions};
@@ -503,7 +546,7 @@ mod tests {
             let mut materials = scene.materials().to_vec();
             for (i, m) in materials.iter_mut().enumerate() {
                 let k = seed as usize + i;
-                m.shading = [ShadingMode::Phong, ShadingMode::Gouraud][k % 2];
+                m.shading = [ShadingMode::Phong, ShadingMode::Gouraud, ShadingMode::Phong, ShadingMode::Flat][k % 4];
                 m.model = [SpecularModel::Phong, SpecularModel::Blinn, SpecularModel::CookTorrance][k % 3];
                 (m.ks, m.shininess, m.roughness) = (0.6, 5.0 + 20.0 * (k % 4) as f32, 0.3);
             }
@@ -512,35 +555,59 @@ mod tests {
             let samples: Vec<_> = scene.lights.iter().map(Light::samples).collect();
             let shader = Shader::new(&scene, &view, &samples);
             let (runs, _) = resolve_frame(&scene, VisibilityMethod::Scanline);
-            let mut rs = RunShading::default();
-            for (y, run) in runs.lines.iter().enumerate().flat_map(|(y, l)| l.iter().map(move |r| (y as u32, r))) {
-                let n = (run.x1 - run.x0) as usize;
-                let lit: Vec<f32> = (0..n).map(|i| [1.0, 0.0, 0.5, 1.0, 0.25][(i + y as usize) % 5]).collect();
-                for (l, s) in samples.iter().enumerate().flat_map(|(l, s)| (0..s.len()).map(move |s| (l, s))) {
-                    let (mut fast, mut slow) = (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]);
-                    shader.begin_run(run, y, &mut rs);
-                    let lanes =
-                        rs.in_lanes && (rs.mode == ShadingMode::Gouraud || shader.lane_light_for(&rs, l, s).is_some());
-                    (in_lanes, in_f64) = if lanes { (in_lanes + 1, in_f64) } else { (in_lanes, in_f64 + 1) };
-                    shader.add_light(&mut rs, l, s, &lit);
-                    shader.finish_run(&rs, &mut fast);
-                    shader.begin_run(run, y, &mut rs);
-                    rs.in_lanes = false;
-                    if !rs.f64_ready {
-                        shader.prepare_f64(&mut rs);
-                    }
-                    shader.add_light(&mut rs, l, s, &lit);
-                    shader.finish_run(&rs, &mut slow);
-                    for (a, b) in fast.iter().zip(&slow) {
-                        let err = (*a - *b).abs().max_element() / b.abs().max_element().max(1.0);
-                        assert!(err < 2e-5, "seed {seed}, line {y}, {run:?}: lanes {a} f64 {b}");
-                        worst = worst.max(err);
-                    }
+            let width = view.width as usize;
+            let count: usize = samples.iter().map(Vec::len).sum();
+            let (mut fast, mut slow) = (LineShading::default(), LineShading { f64_only: true, ..Default::default() });
+            for (y, line) in runs.lines.iter().enumerate() {
+                let lit: Vec<f32> = (0..count * width).map(|i| [1.0, 0.0, 0.5, 1.0, 0.25][(i + y) % 5]).collect();
+                let (mut a, mut b) = (vec![Vec3::ZERO; width], vec![Vec3::ZERO; width]);
+                shader.shade_line(&mut fast, y as u32, line, &lit, &mut a);
+                shader.shade_line(&mut slow, y as u32, line, &lit, &mut b);
+                for (x, (a, b)) in a.iter().zip(&b).enumerate() {
+                    let err = (*a - *b).abs().max_element() / b.abs().max_element().max(1.0);
+                    assert!(err < 2e-5, "seed {seed}, pixel ({x}, {y}): lanes {a} f64 {b}");
+                    worst = worst.max(err);
                 }
             }
+            (in_lanes, in_f64) = (in_lanes + fast.runs_in_lanes, in_f64 + fast.runs_in_f64);
+            assert_eq!(slow.runs_in_lanes, 0);
         }
         assert!(in_lanes > 1000 && in_f64 > 50, "{in_lanes} runs in lanes, {in_f64} in f64");
         eprintln!("worst difference {worst:e} over {in_lanes} runs in lanes");
+    }
+
+    /// Background pixels between runs and after the last are the background colour, and a
+    /// line shaded twice (scratch kept) comes out the same.
+    #[test]
+    fn a_line_is_background_outside_its_runs() {
+        use crate::generate::{random, RandomOptions};
+        use crate::visibility::{resolve_frame, VisibilityMethod};
+        let mut scene = random(3, RandomOptions { polygons: 6, width: 61, height: 40 }).unwrap();
+        scene.render.background = Vec3::new(0.25, 0.5, 0.75);
+        let view = View::new(&scene.camera);
+        let samples: Vec<_> = scene.lights.iter().map(Light::samples).collect();
+        let shader = Shader::new(&scene, &view, &samples);
+        let (runs, _) = resolve_frame(&scene, VisibilityMethod::Scanline);
+        let count: usize = samples.iter().map(Vec::len).sum();
+        let lit = vec![1.0; count * 61];
+        let mut ls = LineShading::default();
+        let mut gaps = 0;
+        for (y, line) in runs.lines.iter().enumerate() {
+            let mut out = vec![Vec3::splat(f32::NAN); 61];
+            shader.shade_line(&mut ls, y as u32, line, &lit, &mut out);
+            let mut again = vec![Vec3::ZERO; 61];
+            shader.shade_line(&mut ls, y as u32, line, &lit, &mut again);
+            assert_eq!(out, again);
+            for (x, c) in out.iter().enumerate() {
+                let covered = line.iter().any(|r| (r.x0..r.x1).contains(&(x as u32)));
+                assert!(c.is_finite());
+                if !covered {
+                    assert_eq!(*c, scene.render.background, "pixel ({x}, {y})");
+                    gaps += 1;
+                }
+            }
+        }
+        assert!(gaps > 100, "{gaps} background pixels");
     }
 
     fn mat(model: SpecularModel) -> Material {
