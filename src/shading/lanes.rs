@@ -64,12 +64,12 @@ pub(super) struct RunGeometry {
     /// `−plane(eye)`, and the plane normal's dot product with `ray` and with `step`.
     pub depth: f32,
     pub den: [f32; 2],
-    /// `s = (num₀ + i num₁) / (div₀ + i div₁)`.
-    pub s_num: [f32; 2],
-    pub s_div: [f32; 2],
-    /// For Phong shading: the normals at the two crossings, and the plane's (for a blend
-    /// that cancels to zero), all turned toward the viewer.
-    pub normals: [[f32; 3]; 3],
+    /// Gouraud: `s = (num₀ + i num₁) / (div₀ + i div₁)`, as `[num, div]`.
+    pub s: [[f32; 2]; 2],
+    /// Phong: the normal at pixel `i` is along `normal₀ + i normal₁`, turned toward the
+    /// viewer, or the plane's `plane` where that is zero.
+    pub normal: [[f32; 3]; 2],
+    pub plane: [f32; 3],
 }
 
 /// A light sample as the lanes see it.
@@ -171,8 +171,9 @@ fn index(g: usize) -> f32x8 {
 
 /// `s` of the lanes at `i`, in `[0, 1]`.
 fn s_at(g: &RunGeometry, i: f32x8) -> f32x8 {
-    let s = i.mul_add(f32x8::splat(g.s_num[1]), f32x8::splat(g.s_num[0]))
-        / i.mul_add(f32x8::splat(g.s_div[1]), f32x8::splat(g.s_div[0]));
+    let [num, div] = g.s;
+    let s =
+        i.mul_add(f32x8::splat(num[1]), f32x8::splat(num[0])) / i.mul_add(f32x8::splat(div[1]), f32x8::splat(div[0]));
     // Not-a-number (a zero divisor) fails the first test and becomes 0.
     s.simd_ge(f32x8::ZERO).select(s, f32x8::ZERO).min(f32x8::ONE)
 }
@@ -255,16 +256,13 @@ impl LineLanes {
     /// Phong: writes the point and normal of each of the run's `len` pixels from `x0`, for
     /// [`LineLanes::shade_phong`] to light with `material`.
     pub fn phong_run(&mut self, x0: usize, len: usize, g: &RunGeometry, material: u32) {
-        let [left, right, plane] = g.normals;
         let (ray, step) = (splat(g.ray), splat(g.step));
         let (depth, den) = (f32x8::splat(g.depth), g.den.map(f32x8::splat));
-        let (left, slope) = (splat(left), splat([0, 1, 2].map(|c| right[c] - left[c])));
-        let plane = splat(plane);
+        let (n0, n1, plane) = (splat(g.normal[0]), splat(g.normal[1]), splat(g.plane));
         for group in 0..len.div_ceil(W) {
             let (i, at, n) = (index(group), x0 + W * group, (len - W * group).min(W));
-            let s = s_at(g, i);
             let t = depth / i.mul_add(den[1], den[0]);
-            let normal = normalize([0, 1, 2].map(|c| s.mul_add(slope[c], left[c])), &plane);
+            let normal = normalize([0, 1, 2].map(|c| i.mul_add(n1[c], n0[c])), &plane);
             for c in 0..3 {
                 store(flat_mut(&mut self.q[c]), at, n, i.mul_add(step[c], ray[c]) * t);
                 store(flat_mut(&mut self.normal[c]), at, n, normal[c]);

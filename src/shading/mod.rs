@@ -168,8 +168,12 @@ struct RunShading {
     /// where the polygon meets the scan plane.
     crossings: Vec<ScanCrossing>,
     along: DVec3,
-    /// The larger `|p - eye|` of the run's ends (for runs in lanes).
+    /// The larger `|p - eye|` of the run's ends (for runs in lanes), the ray through its
+    /// first pixel, and its plane's `depth` and `den` (see [`lanes`]).
     reach: f64,
+    ray: DVec3,
+    depth: f64,
+    den: [f64; 2],
     /// The f64 path: world point seen at each pixel, its value as weights of up to four of
     /// the polygon's vertices, the interpolated unit normal (Phong mode), and the light.
     points: Vec<DVec3>,
@@ -293,7 +297,12 @@ impl<'a> Shader<'a> {
         lit: impl Fn(usize) -> &'l [f32],
     ) -> bool {
         self.scan_crossings(rs);
-        let geometry = if f64_only { None } else { self.lane_geometry(rs, false) };
+        let geometry = if f64_only { None } else { self.lane_geometry(rs) };
+        let geometry = geometry.and_then(|mut g| {
+            let (num, div) = self.s_between_crossings(rs)?;
+            g.s = [num, div].map(|v| v.map(|x| x as f32));
+            Some(g)
+        });
         if let Some(g) = &geometry {
             lanes.gouraud_run(g, rs.len as usize);
         } else {
@@ -332,12 +341,23 @@ impl<'a> Shader<'a> {
         f64_only: bool,
         lit: impl Fn(usize) -> &'l [f32],
     ) -> bool {
-        self.scan_crossings(rs);
-        let geometry = if f64_only { None } else { self.lane_geometry(rs, true) };
-        if let Some(g) = geometry.filter(|_| self.lights_fit_lanes(rs)) {
-            let material = self.scene.objects[self.scene.polygons[rs.poly].object as usize].material;
-            lanes.phong_run(rs.x0 as usize, rs.len as usize, &g, material as u32);
-            return true;
+        let triangle = self.scene.polygons[rs.poly].len == 3;
+        if !triangle {
+            self.scan_crossings(rs);
+        }
+        let geometry = if f64_only { None } else { self.lane_geometry(rs) };
+        if let Some(mut g) = geometry.filter(|_| self.lights_fit_lanes(rs)) {
+            let normal = if triangle { self.triangle_normals(rs) } else { self.crossing_normals(rs) };
+            if let Some(normal) = normal {
+                g.normal = normal.map(|n| n.as_vec3().to_array());
+                g.plane = (self.scene.polygons[rs.poly].plane.n * rs.flip).as_vec3().to_array();
+                let material = self.scene.objects[self.scene.polygons[rs.poly].object as usize].material;
+                lanes.phong_run(rs.x0 as usize, rs.len as usize, &g, material as u32);
+                return true;
+            }
+        }
+        if triangle {
+            self.scan_crossings(rs);
         }
         self.prepare_f64(rs, true);
         for (l, s, k) in self.samples() {
@@ -353,6 +373,35 @@ impl<'a> Shader<'a> {
             lanes.add(rs.x0 as usize, &rs.light);
         }
         false
+    }
+
+    /// A triangle's interpolated normal at pixel `x0 + i` of the run, unnormalised:
+    /// `N₀ + i N₁`. The barycentric weight of vertex `k` seen along a ray `d` from the eye
+    /// is `e_k·d / Σ e_j·d`, with `e_k` the cross product of the other two vertices (less
+    /// the eye), so the weighted sum of the vertex normals, times the denominator, is
+    /// linear in `d` and so in `i`; the denominator's sign is the same over the triangle.
+    /// Equal to the crossings' interpolation (linear along the edges, then along the scan
+    /// plane), which for a triangle is barycentric.
+    fn triangle_normals(&self, rs: &RunShading) -> Option<[DVec3; 2]> {
+        let v = self.scene.verts(rs.poly);
+        let vn = self.scene.vertex_normals(rs.poly);
+        let eye = self.view.eye;
+        let [a, b, c] = [v[0] - eye, v[1] - eye, v[2] - eye];
+        let e = [b.cross(c), c.cross(a), a.cross(b)];
+        let sign = (e[0] + e[1] + e[2]).dot(rs.ray).signum() * rs.flip;
+        let along = |d: DVec3| (vn[0] * e[0].dot(d) + vn[1] * e[1].dot(d) + vn[2] * e[2].dot(d)) * sign;
+        Some([along(rs.ray), along(self.view.ray_step())])
+    }
+
+    /// A run's interpolated normal between its two crossings, unnormalised, as
+    /// `N₀ + i N₁`: with `s = num/div`, `(1 − s) n_l + s n_r` times `div`.
+    fn crossing_normals(&self, rs: &RunShading) -> Option<[DVec3; 2]> {
+        let ((l, r), (num, div)) = (self.crossing_pair(rs)?, self.s_between_crossings(rs)?);
+        let vn = self.scene.vertex_normals(rs.poly);
+        let at = |c: ScanCrossing| crossing_value(vn, c, |v| *v) * rs.flip;
+        let (nl, nr) = (at(l), at(r));
+        let sign = div[0].signum();
+        Some([0, 1].map(|k| (nl * (div[k] - num[k]) + nr * num[k]) * sign))
     }
 
     /// Fills `rs.crossings` and `rs.along`.
@@ -378,12 +427,9 @@ impl<'a> Shader<'a> {
         rs.crossings.sort_unstable_by(|a, b| a.u.total_cmp(&b.u));
     }
 
-    /// The lanes' coefficients for a run whose line crosses the outline twice, if its points
-    /// fit single precision ([`LANE_REACH`]); with the normals at the crossings for Phong.
-    fn lane_geometry(&self, rs: &mut RunShading, phong: bool) -> Option<RunGeometry> {
-        if rs.crossings.len() != 2 {
-            return None;
-        }
+    /// Where the run's rays meet its polygon's plane, as the lanes take it, if its points fit
+    /// single precision ([`LANE_REACH`]); keeps the f64 values in `rs` for what follows.
+    fn lane_geometry(&self, rs: &mut RunShading) -> Option<RunGeometry> {
         let plane = &self.scene.polygons[rs.poly].plane;
         let step = self.view.ray_step();
         let ray = rs.ray_row + step * rs.x0 as f64;
@@ -394,32 +440,37 @@ impl<'a> Shader<'a> {
         if rs.reach.is_nan() || rs.reach >= LANE_REACH {
             return None;
         }
-        let (l, r) = (rs.crossings[0], rs.crossings[1]);
-        // s = (u - u_l) / (u_r - u_l), with u = depth (ray_i . along) / den_i.
-        let (s_num, s_div) = if r.u > l.u {
-            let du = r.u - l.u;
-            let num = [depth * ray.dot(rs.along) - l.u * den[0], depth * step.dot(rs.along) - l.u * den[1]];
-            (num, [du * den[0], du * den[1]])
-        } else {
-            ([0.5, 0.0], [1.0, 0.0])
-        };
-        let normals = if phong {
-            let vn = self.scene.vertex_normals(rs.poly);
-            let at = |c: ScanCrossing| crossing_value(vn, c, |v| *v) * rs.flip;
-            [at(l), at(r), plane.n * rs.flip].map(|v| v.as_vec3().to_array())
-        } else {
-            [[0.0; 3]; 3]
-        };
-        let f32s = |v: [f64; 2]| v.map(|x| x as f32);
+        (rs.ray, rs.depth, rs.den) = (ray, depth, den);
         Some(RunGeometry {
             ray: ray.as_vec3().to_array(),
             step: step.as_vec3().to_array(),
             depth: depth as f32,
-            den: f32s(den),
-            s_num: f32s(s_num),
-            s_div: f32s(s_div),
-            normals,
+            den: den.map(|x| x as f32),
+            s: [[0.0; 2]; 2],
+            normal: [[0.0; 3]; 2],
+            plane: [0.0; 3],
         })
+    }
+
+    /// The run's two crossings, left to right, if its line crosses the outline just twice.
+    fn crossing_pair(&self, rs: &RunShading) -> Option<(ScanCrossing, ScanCrossing)> {
+        match rs.crossings[..] {
+            [l, r] => Some((l, r)),
+            _ => None,
+        }
+    }
+
+    /// `s = (num₀ + i num₁) / (div₀ + i div₁)`, the place of pixel `x0 + i` between the two
+    /// crossings (after [`Shader::lane_geometry`]): `s = (u − u_l) / (u_r − u_l)` with
+    /// `u = depth (ray_i · along) / den_i`.
+    fn s_between_crossings(&self, rs: &RunShading) -> Option<([f64; 2], [f64; 2])> {
+        let (l, r) = self.crossing_pair(rs)?;
+        if r.u <= l.u {
+            return Some(([0.5, 0.0], [1.0, 0.0]));
+        }
+        let (du, depth, den, step) = (r.u - l.u, rs.depth, rs.den, self.view.ray_step());
+        let num = [depth * rs.ray.dot(rs.along) - l.u * den[0], depth * step.dot(rs.along) - l.u * den[1]];
+        Some((num, [du * den[0], du * den[1]]))
     }
 
     /// Whether every point light sample is far enough from the run's plane for the lanes
@@ -540,7 +591,7 @@ mod tests {
     fn lanes_agree_with_the_f64_path_on_random_scenes() {
         use crate::generate::{random, RandomOptions};
         use crate::visibility::{resolve_frame, VisibilityMethod};
-        let (mut worst, mut in_lanes, mut in_f64) = (0.0f32, 0, 0);
+        let (mut worst, mut in_lanes, mut in_f64, mut triangle_runs) = (0.0f32, 0, 0, 0);
         for seed in 0..40u64 {
             let mut scene = random(seed, RandomOptions { polygons: 8, width: 96, height: 72 }).unwrap();
             let mut materials = scene.materials().to_vec();
@@ -551,10 +602,15 @@ mod tests {
                 (m.ks, m.shininess, m.roughness) = (0.6, 5.0 + 20.0 * (k % 4) as f32, 0.3);
             }
             scene.set_materials(materials).unwrap();
+            // Vertex normals that vary over each polygon, for the interpolation to show.
+            for (n, v) in scene.normals.iter_mut().zip(&scene.vertices) {
+                *n = (*n + 0.5 * DVec3::new((3.0 * v.x).sin(), (5.0 * v.y).cos(), (4.0 * v.z).sin())).normalize();
+            }
             let view = View::new(&scene.camera);
             let samples: Vec<_> = scene.lights.iter().map(Light::samples).collect();
             let shader = Shader::new(&scene, &view, &samples);
             let (runs, _) = resolve_frame(&scene, VisibilityMethod::Scanline);
+            triangle_runs += runs.lines.iter().flatten().filter(|r| scene.polygons[r.poly as usize].len == 3).count();
             let width = view.width as usize;
             let count: usize = samples.iter().map(Vec::len).sum();
             let (mut fast, mut slow) = (LineShading::default(), LineShading { f64_only: true, ..Default::default() });
@@ -573,7 +629,8 @@ mod tests {
             assert_eq!(slow.runs_in_lanes, 0);
         }
         assert!(in_lanes > 1000 && in_f64 > 50, "{in_lanes} runs in lanes, {in_f64} in f64");
-        eprintln!("worst difference {worst:e} over {in_lanes} runs in lanes");
+        assert!(triangle_runs > 500, "{triangle_runs} runs on triangles");
+        eprintln!("worst difference {worst:e} over {in_lanes} runs in lanes, {triangle_runs} on triangles");
     }
 
     /// Background pixels between runs and after the last are the background colour, and a
