@@ -188,6 +188,10 @@ struct RenderArgs {
     /// onto receiver planes). Or none. The default is the recommended exact method.
     #[arg(long, default_value = ShadowMethod::DEFAULT.name(), value_parser = parse::<ShadowMethod>)]
     shadows: ShadowMethod,
+    /// Keep closed solids' polygons that turn their backs to the eye in the hidden-surface
+    /// stage (by default they are left out: they are never seen).
+    #[arg(long)]
+    no_back_face_cull: bool,
     #[command(flatten)]
     shadow: ShadowArgs,
     /// Write the analysis buffers id.png and light<k>.png into this folder, with per-pixel
@@ -256,6 +260,10 @@ struct BenchArgs {
     /// One JSON object per row instead of a table.
     #[arg(long)]
     json: bool,
+    /// Keep closed solids' polygons that turn their backs to the eye in the hidden-surface
+    /// stage (by default they are left out: they are never seen).
+    #[arg(long)]
+    no_back_face_cull: bool,
     #[command(flatten)]
     shadow: ShadowArgs,
 }
@@ -507,6 +515,7 @@ fn render_command(a: RenderArgs) -> umbra::Result<()> {
         pixel_counters: a.aov.is_some(),
         reflection: a.reflection,
         outlines: a.debug.is_some(),
+        back_face_cull: !a.no_back_face_cull,
     };
     let bar = Arc::new(TerminalBar::new("{msg:40} {bar:30} {pos}/{len} lines {elapsed}"));
     let shown = bar.clone();
@@ -575,6 +584,7 @@ fn bench_command(a: BenchArgs) -> umbra::Result<()> {
         shadows: a.shadow.configure_all(a.shadows),
         warmup: a.warmup,
         runs: a.runs,
+        back_face_cull: !a.no_back_face_cull,
     };
     let threads = a.threads.unwrap_or(0);
     let pool = rayon::ThreadPoolBuilder::new()

@@ -35,6 +35,11 @@ pub struct RenderOptions {
     /// polygons) for the first light sample in [`Renderer::outlines`], to draw them over the
     /// image.
     pub outlines: bool,
+    /// Leave out of the hidden-surface stage the polygons of closed solids that turn their
+    /// backs to the eye (when the eye is outside the solid's bounds): they are never seen.
+    /// On by default; the images are the same either way, up to which of two polygons meeting
+    /// at a silhouette edge is seen exactly on it.
+    pub back_face_cull: bool,
 }
 
 impl Default for RenderOptions {
@@ -45,6 +50,7 @@ impl Default for RenderOptions {
             outlines: false,
             pixel_counters: false,
             reflection: crate::reflection::ReflectionMethod::default(),
+            back_face_cull: true,
         }
     }
 }
@@ -71,7 +77,7 @@ struct Band<'f> {
     tests: Option<&'f mut [u32]>,
 }
 
-/// How many screen polygons cover each pixel centre.
+/// How many of the polygons of `screen` cover each pixel centre.
 fn depth_complexity(screen: &Screen, w: u32, h: u32) -> Vec<u32> {
     let mut count = vec![0u32; (w * h) as usize];
     let mut table = crate::scan::EdgeTable::new(h);
@@ -253,7 +259,13 @@ fn frame_pass(
 
     let t = Instant::now();
     bar.phase("view: clipping and projecting");
-    let screen = view.screen_polygons_in(scene, |_| true, pools.stash.take());
+    let whole = view.solids_past_near_plane(scene);
+    let eye = crate::scene::LightSample::Point(view.eye);
+    let seen = |i: usize| {
+        let solid = scene.solid_of[i] as usize;
+        !(opts.back_face_cull && whole.get(solid) == Some(&true) && scene.turned_away_on_solid(i, eye))
+    };
+    let screen = view.screen_polygons_in(scene, seen, pools.stash.take());
     stats.visibility_counters.add("screen_polygons", screen.len() as u64);
     stats.time_ms.insert("view", ms(t.elapsed()));
 
@@ -323,7 +335,9 @@ fn visible_runs(
         let mut splits = vec![0u16; (w * h) as usize];
         visibility.span_splits(0..h, &mut splits);
         PixelCounters {
-            depth_complexity: depth_complexity(screen, w, h),
+            // Every polygon in front of the eye counts, those the hidden-surface stage
+            // left out as turned away included.
+            depth_complexity: depth_complexity(&view.screen_polygons(scene), w, h),
             span_splits: splits.into_iter().map(u32::from).collect(),
             shadow_tests: vec![0; (w * h) as usize],
         }

@@ -339,6 +339,18 @@ impl View {
         true
     }
 
+    /// Which of the scene's closed solids lie wholly beyond the near plane: no polygon of
+    /// theirs is clipped, so each ray from the eye that reaches a polygon of theirs turned
+    /// away from the eye has met one facing it first ([`Scene::turned_away_on_solid`]). (A
+    /// far plane clips the farther of the two first.)
+    pub(crate) fn solids_past_near_plane(&self, scene: &Scene) -> Vec<bool> {
+        let depth = |p: DVec3| (p - self.eye).dot(self.f);
+        let corners = |lo: DVec3, hi: DVec3| {
+            (0..8).map(move |k| DVec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo))
+        };
+        scene.solids.iter().map(|s| corners(s.lo, s.hi).all(|c| depth(c) > self.near)).collect()
+    }
+
     /// Every polygon of the scene that survives clipping, in screen space.
     pub(crate) fn screen_polygons(&self, scene: &Scene) -> Screen {
         self.screen_polygons_in(scene, |_| true, Screen::default())

@@ -759,6 +759,22 @@ impl Scene {
         &self.vertices[p.start as usize..(p.start + p.len) as usize]
     }
 
+    /// Whether polygon `i` belongs to a closed solid, turns its back to `from` (a light
+    /// sample or the eye), and `from` lies outside the solid's bounds (a directional light
+    /// always does). Seen from `from`, such a polygon is covered everywhere by a polygon of
+    /// the same solid that faces `from`, nearer along every ray (where the two meet, at
+    /// their shared edge, at the same distance): it never casts a shadow, and is never the
+    /// nearest polygon seen. Ours, not the papers'; see `docs/algorithms/bouknight-kelley.md`,
+    /// "Speed-ups that are ours", and `docs/algorithms/scanline.md`.
+    pub(crate) fn turned_away_on_solid(&self, i: usize, from: LightSample) -> bool {
+        let Some(solid) = self.solids.get(self.solid_of[i] as usize) else { return false };
+        let outside = match from {
+            LightSample::Point(s) => solid.outside(s),
+            LightSample::Directional(_) => true,
+        };
+        outside && from.side_of(&self.polygons[i].plane) * solid.sign < 0.0
+    }
+
     /// The vertex normals of polygon `i`.
     #[inline]
     pub fn vertex_normals(&self, i: usize) -> &[DVec3] {

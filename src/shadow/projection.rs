@@ -27,17 +27,11 @@ pub fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> boo
 }
 
 /// Whether polygon `i` belongs to a closed solid, faces away from the light sample, and the
-/// sample lies outside the solid's bounds (a directional light always does). Such a polygon
-/// never needs to cast: a shadow ray that crosses it has crossed, nearer the light, a polygon
-/// of the same solid that faces the light (ours, not the papers'; see
-/// `docs/algorithms/bouknight-kelley.md`, "Speed-ups that are ours").
+/// sample lies outside the solid's bounds: such a polygon never needs to cast, since a
+/// shadow ray that crosses it has crossed, nearer the light, a polygon of the same solid
+/// that faces the light ([`Scene::turned_away_on_solid`]).
 pub fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample) -> bool {
-    let Some(solid) = scene.solids.get(scene.solid_of[i] as usize) else { return false };
-    let outside = match sample {
-        LightSample::Point(s) => solid.outside(s),
-        LightSample::Directional(_) => true,
-    };
-    outside && sample.side_of(&scene.polygons[i].plane) * solid.sign < 0.0
+    scene.turned_away_on_solid(i, sample)
 }
 
 /// Projects polygons from a light sample onto a bounded piece of a plane, keeping the scratch

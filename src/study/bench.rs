@@ -24,6 +24,8 @@ pub struct BenchOptions {
     pub warmup: usize,
     /// Timed frames.
     pub runs: usize,
+    /// See [`RenderOptions::back_face_cull`].
+    pub back_face_cull: bool,
 }
 
 /// Median, least and greatest of a set of times, in milliseconds.
@@ -110,7 +112,12 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
     for &v in &o.visibility {
         for s in &o.shadows {
             progress(&format!("{v} + {s}"));
-            let opts = RenderOptions { visibility: v, shadows: s.clone(), ..RenderOptions::default() };
+            let opts = RenderOptions {
+                visibility: v,
+                shadows: s.clone(),
+                back_face_cull: o.back_face_cull,
+                ..RenderOptions::default()
+            };
             let m = measure(scene, &opts, o.warmup, o.runs)?;
             rows.push(BenchRow {
                 visibility: v.name().into(),

@@ -59,3 +59,37 @@ fn generated_benchmark_scenes_agree() {
         }
     }
 }
+
+/// Closed solids' polygons turned away from the eye are left out of the hidden-surface
+/// stage: about half of a scene of spheres, with nothing seen changed (both frames agree
+/// with ray-cast), and none of a solid that the near plane cuts open or that holds the eye.
+#[test]
+fn back_faces_of_closed_solids_are_left_out_and_nothing_seen_changes() {
+    let screen = |scene: &umbra::Scene, cull: bool, v: VisibilityMethod| {
+        let opts = umbra::RenderOptions {
+            visibility: v,
+            shadows: ShadowMethod::None,
+            back_face_cull: cull,
+            ..Default::default()
+        };
+        let r = umbra::render(scene, &opts).unwrap();
+        (r.stats.visibility_counters.get("screen_polygons"), r.frame)
+    };
+    let spheres = umbra::generate::spheres(2000, 4, 160, 90).unwrap();
+    let reference = frame(&spheres, VisibilityMethod::RayCast, ShadowMethod::None);
+    for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
+        let ((culled, a), (all, b)) = (screen(&spheres, true, v), screen(&spheres, false, v));
+        assert!(culled * 10 < all * 6 && culled * 10 > all * 3, "{v}: {culled} of {all} screen polygons kept");
+        assert_ids_agree(&spheres, &reference, &a, &format!("{v} culled"));
+        assert_ids_agree(&spheres, &reference, &b, &format!("{v} not culled"));
+    }
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/robustness");
+    // The near plane cuts the torus open: none left out. The eye is inside the room: only
+    // the three faces of the box in the room that turn away from it are left out.
+    for (name, left_out) in [("torus_near_cut.toml", 0), ("eye_inside_box.toml", 3)] {
+        let scene = umbra::Scene::load(data.join(name)).unwrap();
+        let (culled, _) = screen(&scene, true, VisibilityMethod::Scanline);
+        let (all, _) = screen(&scene, false, VisibilityMethod::Scanline);
+        assert_eq!(all - culled, left_out, "{name}");
+    }
+}
