@@ -482,6 +482,8 @@ pub struct Scene {
     /// change of the polygons since), shared by clones, so that what a renderer derives from
     /// the polygons (Crow's edge adjacency) can be kept for the next frame of the same scene.
     pub(crate) polygons_id: u64,
+    /// The vertices' bounds, found when they change.
+    bounds: Option<(DVec3, DVec3)>,
 }
 
 /// The next [`Scene::polygons_id`].
@@ -540,6 +542,7 @@ impl Scene {
             solid_of: Vec::new(),
             solids: Vec::new(),
             polygons_id: next_polygons_id(),
+            bounds: None,
         };
         scene.compile().map_err(Error::InvalidOption)?;
         Ok(scene)
@@ -617,6 +620,7 @@ impl Scene {
             self.solid_of.extend(of);
             self.solids.extend(found);
         }
+        self.bounds = self.vertex_bounds();
         Ok(())
     }
 
@@ -790,6 +794,7 @@ impl Scene {
         self.solid_of.clear();
         self.solid_of.resize(self.polygons.len(), solids::NO_SOLID);
         self.polygons_id = next_polygons_id();
+        self.bounds = self.vertex_bounds();
     }
 
     /// Whether polygon `i` casts shadows.
@@ -806,6 +811,10 @@ impl Scene {
 
     /// The axis-aligned bounds of all polygons (`None` when there are none).
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
+        self.bounds
+    }
+
+    fn vertex_bounds(&self) -> Option<(DVec3, DVec3)> {
         let first = *self.vertices.first()?;
         Some(self.vertices.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
     }
