@@ -319,13 +319,9 @@ impl<'a> Shader<'a> {
                 continue;
             }
             let (weights, colors) = (&rs.weights, &rs.vertex_colors);
-            rs.light.clear();
-            rs.light.extend(weights.iter().zip(lit(k)).map(|(w, &v)| {
-                let c: Vec3 =
-                    if v == 0.0 { Vec3::ZERO } else { w.iter().map(|&(k, a)| colors[k as usize] * a as f32).sum() };
-                c * v
-            }));
-            lanes.add(rs.x0 as usize, &rs.light);
+            add_f64(&mut rs.light, lanes, rs.x0 as usize, lit(k), |i| {
+                weights[i].iter().map(|&(k, a)| colors[k as usize] * a as f32).sum()
+            });
         }
         geometry.is_some()
     }
@@ -362,15 +358,7 @@ impl<'a> Shader<'a> {
         self.prepare_f64(rs, true);
         for (l, s, k) in self.samples() {
             let (points, normals) = (&rs.points, &rs.normals);
-            rs.light.clear();
-            rs.light.extend(lit(k).iter().enumerate().map(|(i, &v)| {
-                if v == 0.0 {
-                    Vec3::ZERO
-                } else {
-                    self.shade(rs.poly, l, s, points[i], normals[i]) * v
-                }
-            }));
-            lanes.add(rs.x0 as usize, &rs.light);
+            add_f64(&mut rs.light, lanes, rs.x0 as usize, lit(k), |i| self.shade(rs.poly, l, s, points[i], normals[i]));
         }
         false
     }
@@ -536,6 +524,14 @@ impl<'a> Shader<'a> {
             rs.weights.push(w);
         }
     }
+}
+
+/// The f64 path's light: adds `color(i)` times the lit value of every lit pixel `i` of the run
+/// at `x0` (through `light`, scratch).
+fn add_f64(light: &mut Vec<Vec3>, lanes: &mut LineLanes, x0: usize, lit: &[f32], color: impl Fn(usize) -> Vec3) {
+    light.clear();
+    light.extend(lit.iter().enumerate().map(|(i, &v)| if v == 0.0 { Vec3::ZERO } else { color(i) * v }));
+    lanes.add(x0, light);
 }
 
 /// A channel that overflowed (to infinity, or to not-a-number through infinity times zero
