@@ -91,10 +91,12 @@ fn shadow_polygons(
     let n = scene.polygons.len();
     counters.add("pairs", (n as u64) * (n as u64).saturating_sub(1));
     let receivers: Vec<u32> = (0..n as u32)
+        .into_par_iter()
         .filter(|&i| ctx.visible[i as usize] && sample.on_seen_side(&scene.polygons[i as usize].plane, ctx.view.eye))
         .collect();
     let casting = |i: usize| scene.casts_shadows(i) && !edge_on(scene, i, sample, ctx.extent);
     let (casters, dropped): (Vec<u32>, Vec<u32>) = (0..n as u32)
+        .into_par_iter()
         .filter(|&i| casting(i as usize))
         .partition(|&i| !(options.solid_cull && faces_away_on_solid(scene, i as usize, sample)));
     if options.solid_cull {
@@ -105,7 +107,7 @@ fn shadow_polygons(
     counters.add("pairs_with_roles", receivers.len() as u64 * casters.len() as u64);
 
     let t = Instant::now();
-    let grid = options.prefilter.then(|| SphereGrid::new(scene, sample, &casters));
+    let grid = options.prefilter.then(|| SphereGrid::new(scene, sample, &casters, &receivers));
     counters.add("prefilter_grid_us", t.elapsed().as_micros() as u64);
 
     let per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>, Pairs)> = receivers
@@ -280,6 +282,11 @@ struct Extent {
     cone: (DVec3, f64),
 }
 
+impl Extent {
+    /// The extent of a polygon that is neither caster nor receiver (never asked about).
+    const NONE: Extent = Extent { boxes: [None, None], cone: (DVec3::Y, 0.0) };
+}
+
 /// Step 2, the sphere prefilter: every polygon's extent on the sphere around the light (on
 /// the plane across a directional light), and a grid over the extents' domain (polar angle ×
 /// azimuth, or the plane's two axes) in which each caster is binned in every cell its extent
@@ -291,14 +298,25 @@ struct SphereGrid {
     cone_cs: Vec<(f64, f64)>,
     domain: [f64; 4],
     g: usize,
-    cells: Vec<Vec<u32>>,
+    /// The casters binned in cell `k` (column-major, `c * g + r`) are
+    /// `binned[first[k]..first[k + 1]]`, in increasing order.
+    first: Vec<u32>,
+    binned: Vec<u32>,
     point: bool,
 }
 
 impl SphereGrid {
-    fn new(scene: &Scene, sample: LightSample, casters: &[u32]) -> Self {
+    fn new(scene: &Scene, sample: LightSample, casters: &[u32], receivers: &[u32]) -> Self {
         let n = scene.polygons.len();
-        let extents: Vec<Extent> = (0..n).into_par_iter().map(|i| extent(scene.verts(i), sample)).collect();
+        // Only casters and receivers are asked about.
+        let mut wanted = vec![false; n];
+        for &i in casters.iter().chain(receivers) {
+            wanted[i as usize] = true;
+        }
+        let extents: Vec<Extent> = (0..n)
+            .into_par_iter()
+            .map(|i| if wanted[i] { extent(scene.verts(i), sample) } else { Extent::NONE })
+            .collect();
         let domain = match sample {
             LightSample::Point(_) => [0.0, -PI, PI, PI],
             LightSample::Directional(_) => extents
@@ -309,23 +327,43 @@ impl SphereGrid {
                 }),
         };
         let g = ((casters.len() as f64).sqrt().ceil() as usize).clamp(4, 1024);
-        let cone_cs = extents.iter().map(|e| (e.cone.1.cos(), e.cone.1.sin())).collect();
+        let cone_cs = extents.par_iter().map(|e| (e.cone.1.cos(), e.cone.1.sin())).collect();
         let mut grid = SphereGrid {
             extents,
             cone_cs,
             domain,
             g,
-            cells: vec![Vec::new(); g * g],
+            first: Vec::new(),
+            binned: Vec::new(),
             point: matches!(sample, LightSample::Point(_)),
         };
-        let mut cells = std::mem::take(&mut grid.cells);
-        for &i in casters {
-            for (c, r) in grid.cells_of(i) {
-                cells[c * g + r].push(i);
-            }
+        // Every (cell, caster) pair, found in parallel and in caster order, then counted
+        // into the cells (a stable counting sort: each cell lists its casters in order).
+        let binned: Vec<(u32, u32)> = casters
+            .par_iter()
+            .flat_map_iter(|&i| grid.cells_of(i).map(move |(c, r)| ((c * g + r) as u32, i)))
+            .collect();
+        let mut first = vec![0u32; g * g + 1];
+        for &(k, _) in &binned {
+            first[k as usize + 1] += 1;
         }
-        grid.cells = cells;
+        for k in 0..g * g {
+            first[k + 1] += first[k];
+        }
+        let mut next = first.clone();
+        grid.binned = vec![0; binned.len()];
+        for (k, i) in binned {
+            grid.binned[next[k as usize] as usize] = i;
+            next[k as usize] += 1;
+        }
+        grid.first = first;
         grid
+    }
+
+    /// The casters binned in cell `(c, r)`.
+    fn cell(&self, c: usize, r: usize) -> &[u32] {
+        let k = c * self.g + r;
+        &self.binned[self.first[k] as usize..self.first[k + 1] as usize]
     }
 
     /// The grid cells (column, row) that polygon `i`'s extent touches.
@@ -345,7 +383,7 @@ impl SphereGrid {
         let mut out = Vec::new();
         let (bc, bh) = self.extents[b as usize].cone;
         for (c, r) in self.cells_of(b) {
-            for &a in &self.cells[c * self.g + r] {
+            for &a in self.cell(c, r) {
                 if stamp[a as usize] == b {
                     continue;
                 }
@@ -381,7 +419,9 @@ fn extent(verts: &[DVec3], sample: LightSample) -> Extent {
             if axis == DVec3::ZERO || dirs.contains(&DVec3::ZERO) {
                 return full;
             }
-            let half = dirs.iter().map(|d| d.dot(axis).clamp(-1.0, 1.0).acos()).fold(0.0, f64::max) + 1e-9;
+            // The widest vertex direction's angle: the arccosine of the least cosine.
+            let least = dirs.iter().map(|d| d.dot(axis)).fold(1.0, f64::min).clamp(-1.0, 1.0);
+            let half = least.acos() + 1e-9;
             if half >= PI / 2.0 {
                 return full;
             }
@@ -580,7 +620,7 @@ mod tests {
                 .unwrap();
             let n = scene.polygons.len();
             let casters: Vec<u32> = (0..n as u32).collect();
-            let grid = SphereGrid::new(&scene, LightSample::Point(light), &casters);
+            let grid = SphereGrid::new(&scene, LightSample::Point(light), &casters, &casters);
             let mut stamp = vec![u32::MAX; n];
             let mut found = 0;
             for b in 0..n as u32 {
