@@ -287,8 +287,8 @@ impl LineLanes {
             for at in (x0 / W * W..x1).step_by(W) {
                 // A group the stretch does not fill is shared with its neighbours' pixels.
                 let mask = (at < x0 || at + W > x1).then(|| {
-                    let x = index(0) + at as f32;
-                    x.simd_ge(f32x8::splat(x0 as f32)) & x.simd_lt(f32x8::splat(x1 as f32))
+                    let all = f32::from_bits(u32::MAX);
+                    f32x8::from(std::array::from_fn(|j| if (x0..x1).contains(&(at + j)) { all } else { 0.0 }))
                 });
                 let g = at / W;
                 let pixels = Pixels::new(load3(q, g), load3(normal, g), at);
