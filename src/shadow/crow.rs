@@ -84,6 +84,7 @@ impl ShadowStage for Crow<'_> {
                 })
                 .collect(),
             events: Vec::new(),
+            sweep: Sweep::default(),
             last_pieces: Vec::new(),
             last_counts: Vec::new(),
             last_adds: Vec::new(),
@@ -134,10 +135,20 @@ impl LineState<'_> {
     }
 }
 
+/// The sweep's scratch, all zero between runs: each pixel's change of count, and a bit per
+/// pixel where an event falls.
+#[derive(Default)]
+struct Sweep {
+    changes: Vec<i32>,
+    marks: Vec<u64>,
+}
+
 struct Walker<'s> {
     stage: &'s Crow<'s>,
     lines: Vec<LineState<'s>>,
     events: Vec<(u32, i32)>,
+    /// Scratch for the sweep.
+    sweep: Sweep,
     /// The last run's coverage pieces (polygon, start, end) and its counted pieces.
     last_pieces: Vec<(u32, u32, u32)>,
     last_counts: Vec<(u32, u32, i32)>,
@@ -198,26 +209,45 @@ impl Walker<'_> {
     }
 
     /// Step 3, the count: swept along the run, constant between events; a pixel is in
-    /// shadow where it is above zero.
+    /// shadow where it is above zero. The events are summed into the pixels where they fall
+    /// and those pixels marked in a bit set, which is then read in order: no sorting, and
+    /// time in the number of events, not of pixels.
     fn sweep(&mut self, run: &Run, lit: &mut [f32]) {
-        self.events.sort_unstable_by_key(|e| e.0);
         self.runs += 1;
         self.events_total += self.events.len() as u64;
         self.last_counts.clear();
-        let (mut count, mut x, mut pieces_made) = (0i32, run.x0, 0);
-        let mut i = 0;
-        while x < run.x1 {
-            while i < self.events.len() && self.events[i].0 <= x {
-                count += self.events[i].1;
-                i += 1;
-            }
-            let next = self.events.get(i).map_or(run.x1, |e| e.0.min(run.x1));
-            lit[(x - run.x0) as usize..(next - run.x0) as usize].fill(if count > 0 { 0.0 } else { 1.0 });
-            self.last_counts.push((x, next, count));
-            pieces_made += 1;
-            x = next;
+        let len = (run.x1 - run.x0) as usize;
+        let Sweep { changes, marks } = &mut self.sweep;
+        if changes.len() <= len {
+            changes.resize(len + 1, 0);
+            marks.resize((len + 1).div_ceil(64), 0);
         }
-        if pieces_made > 1 {
+        for &(x, c) in &self.events {
+            let at = ((x - run.x0) as usize).min(len);
+            changes[at] += c;
+            marks[at / 64] |= 1 << (at % 64);
+        }
+        let (mut count, mut start) = (0i32, 0usize);
+        for (word, bits) in marks[..(len + 1).div_ceil(64)].iter_mut().enumerate() {
+            while *bits != 0 {
+                let at = word * 64 + bits.trailing_zeros() as usize;
+                *bits &= *bits - 1;
+                let change = std::mem::take(&mut changes[at]);
+                // An event at the run's end changes nothing in it.
+                if at == len {
+                    continue;
+                }
+                if at > start {
+                    lit[start..at].fill(if count > 0 { 0.0 } else { 1.0 });
+                    self.last_counts.push((run.x0 + start as u32, run.x0 + at as u32, count));
+                    start = at;
+                }
+                count += change;
+            }
+        }
+        lit[start..len].fill(if count > 0 { 0.0 } else { 1.0 });
+        self.last_counts.push((run.x0 + start as u32, run.x1, count));
+        if self.last_counts.len() > 1 {
             self.split += 1;
         }
     }
