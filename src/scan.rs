@@ -302,13 +302,14 @@ impl<'a> ActiveEdges<'a> {
         self.next += 1;
         // Edges whose last line has passed leave; the others step to this line (one pass).
         // An edge moves only when one before it has left.
+        let active = &mut self.active[..];
         let mut kept = 0;
-        for i in 0..self.active.len() {
-            if self.active[i].end > line {
+        for i in 0..active.len() {
+            if active[i].end > line {
                 if kept != i {
-                    self.active[kept] = self.active[i];
+                    active[kept] = active[i];
                 }
-                let c = &mut self.active[kept];
+                let c = &mut active[kept];
                 c.x = c.at(line);
                 kept += 1;
             }
@@ -317,17 +318,18 @@ impl<'a> ActiveEdges<'a> {
         // Insertion sort: the list was sorted on the previous line, and only edges that
         // cross each other between two lines are out of order now (the others are passed
         // over without being moved).
-        for i in 1..self.active.len() {
-            if self.active[i - 1].x <= self.active[i].x {
+        let active = &mut self.active[..];
+        for i in 1..active.len() {
+            if active[i - 1].x <= active[i].x {
                 continue;
             }
-            let item = self.active[i];
+            let item = active[i];
             let mut j = i;
-            while j > 0 && self.active[j - 1].x > item.x {
-                self.active[j] = self.active[j - 1];
+            while j > 0 && active[j - 1].x > item.x {
+                active[j] = active[j - 1];
                 j -= 1;
             }
-            self.active[j] = item;
+            active[j] = item;
         }
         // Edges that start on this line are sorted among themselves, then merged in.
         let entering = self.table.starting_on(line);
@@ -348,15 +350,16 @@ impl<'a> ActiveEdges<'a> {
     fn merge_incoming(&mut self) {
         let (mut i, mut j) = (self.active.len(), self.incoming.len());
         self.active.extend_from_slice(&self.incoming);
-        let mut k = self.active.len();
+        let (active, incoming) = (&mut self.active[..], &self.incoming[..]);
+        let mut k = active.len();
         while j > 0 {
             k -= 1;
-            if i > 0 && self.active[i - 1].x > self.incoming[j - 1].x {
+            if i > 0 && active[i - 1].x > incoming[j - 1].x {
                 i -= 1;
-                self.active[k] = self.active[i];
+                active[k] = active[i];
             } else {
                 j -= 1;
-                self.active[k] = self.incoming[j];
+                active[k] = incoming[j];
             }
         }
     }
