@@ -337,7 +337,11 @@ fn visible_runs(
         PixelCounters {
             // Every polygon in front of the eye counts, those the hidden-surface stage
             // left out as turned away included.
-            depth_complexity: depth_complexity(&view.screen_polygons(scene), w, h),
+            depth_complexity: if opts.back_face_cull {
+                depth_complexity(&view.screen_polygons(scene), w, h)
+            } else {
+                depth_complexity(screen, w, h)
+            },
             span_splits: splits.into_iter().map(u32::from).collect(),
             shadow_tests: vec![0; (w * h) as usize],
         }

@@ -806,7 +806,13 @@ impl Scene {
     /// The material of polygon `i`.
     #[inline]
     pub fn material(&self, i: usize) -> &Material {
-        &self.materials[self.objects[self.polygons[i].object as usize].material]
+        &self.materials[self.material_index(i)]
+    }
+
+    /// The index in the materials of polygon `i`'s material.
+    #[inline]
+    pub(crate) fn material_index(&self, i: usize) -> usize {
+        self.objects[self.polygons[i].object as usize].material
     }
 
     /// The axis-aligned bounds of all polygons (`None` when there are none).

@@ -299,7 +299,8 @@ impl<'a> Shader<'a> {
         self.scan_crossings(rs);
         let geometry = if f64_only { None } else { self.lane_geometry(rs) };
         let geometry = geometry.and_then(|mut g| {
-            let (num, div) = self.s_between_crossings(rs)?;
+            let (l, r) = self.crossing_pair(rs)?;
+            let (num, div) = self.s_between(rs, l, r);
             g.s = [num, div].map(|v| v.map(|x| x as f32));
             Some(g)
         });
@@ -347,8 +348,7 @@ impl<'a> Shader<'a> {
             if let Some(normal) = normal {
                 g.normal = normal.map(|n| n.as_vec3().to_array());
                 g.plane = (self.scene.polygons[rs.poly].plane.n * rs.flip).as_vec3().to_array();
-                let material = self.scene.objects[self.scene.polygons[rs.poly].object as usize].material;
-                lanes.phong_run(rs.x0 as usize, rs.len as usize, &g, material as u32);
+                lanes.phong_run(rs.x0 as usize, rs.len as usize, &g, self.scene.material_index(rs.poly) as u32);
                 return true;
             }
         }
@@ -384,7 +384,8 @@ impl<'a> Shader<'a> {
     /// A run's interpolated normal between its two crossings, unnormalised, as
     /// `N₀ + i N₁`: with `s = num/div`, `(1 − s) n_l + s n_r` times `div`.
     fn crossing_normals(&self, rs: &RunShading) -> Option<[DVec3; 2]> {
-        let ((l, r), (num, div)) = (self.crossing_pair(rs)?, self.s_between_crossings(rs)?);
+        let (l, r) = self.crossing_pair(rs)?;
+        let (num, div) = self.s_between(rs, l, r);
         let vn = self.scene.vertex_normals(rs.poly);
         let at = |c: ScanCrossing| crossing_value(vn, c, |v| *v) * rs.flip;
         let (nl, nr) = (at(l), at(r));
@@ -448,17 +449,16 @@ impl<'a> Shader<'a> {
         }
     }
 
-    /// `s = (num₀ + i num₁) / (div₀ + i div₁)`, the place of pixel `x0 + i` between the two
-    /// crossings (after [`Shader::lane_geometry`]): `s = (u − u_l) / (u_r − u_l)` with
-    /// `u = depth (ray_i · along) / den_i`.
-    fn s_between_crossings(&self, rs: &RunShading) -> Option<([f64; 2], [f64; 2])> {
-        let (l, r) = self.crossing_pair(rs)?;
+    /// `s = (num₀ + i num₁) / (div₀ + i div₁)`, the place of pixel `x0 + i` between the
+    /// crossings `l` and `r` (after [`Shader::lane_geometry`]): `s = (u − u_l) / (u_r − u_l)`
+    /// with `u = depth (ray_i · along) / den_i`.
+    fn s_between(&self, rs: &RunShading, l: ScanCrossing, r: ScanCrossing) -> ([f64; 2], [f64; 2]) {
         if r.u <= l.u {
-            return Some(([0.5, 0.0], [1.0, 0.0]));
+            return ([0.5, 0.0], [1.0, 0.0]);
         }
         let (du, depth, den, step) = (r.u - l.u, rs.depth, rs.den, self.view.ray_step());
         let num = [depth * rs.ray.dot(rs.along) - l.u * den[0], depth * step.dot(rs.along) - l.u * den[1]];
-        Some((num, [du * den[0], du * den[1]]))
+        (num, [du * den[0], du * den[1]])
     }
 
     /// Whether every point light sample is far enough from the run's plane for the lanes
