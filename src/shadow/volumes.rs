@@ -516,6 +516,70 @@ impl ScreenShadowPolygon {
     }
 }
 
+/// The region every sight line z-pass counts along stays in (ours): the convex hull of the
+/// eye and the scene's bounds, grown by a margin. A z-pass count at a visible point P sums
+/// the shadow polygons crossed between the eye (its near point) and P; P lies in the
+/// bounds, so that segment lies in the hull, and the part of a side outside the hull is
+/// crossed by no such segment. Cutting the sides to the hull therefore changes no count,
+/// and a side no longer runs on screen from its edge to the image border: on a floor lit
+/// from above it stops at the floor. (Crow's sides, and Bergeron's, reach the limits of the
+/// environment; this is that limit, taken as tight as the eye allows.) Z-fail counts
+/// behind P, out to infinity, so it keeps its sides whole.
+pub(crate) struct SightHull {
+    /// Half-spaces `n · x + d · w >= 0` (homogeneous `x`, `w`) whose intersection holds the
+    /// hull.
+    planes: Vec<(DVec3, f64)>,
+}
+
+impl SightHull {
+    /// The hull of `eye` and the box `lo..hi` grown by `margin`: the faces of the box the eye
+    /// does not see, and the planes through the eye and each box edge between a face it sees
+    /// and one it does not. A plane that rounding leaves cutting the box is dropped (fewer
+    /// planes only make the region larger, never wrong).
+    pub(crate) fn new((lo, hi): (DVec3, DVec3), margin: f64, eye: DVec3) -> Self {
+        let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
+        let corners: Vec<DVec3> =
+            (0..8).map(|k| DVec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2])).collect();
+        // The six faces, inward: (axis, coordinate, inward normal, offset).
+        let faces: Vec<(usize, f64, DVec3, f64)> = (0..3)
+            .flat_map(|i| {
+                let e = DVec3::AXES[i];
+                [(i, lo[i], e, -lo[i]), (i, hi[i], -e, hi[i])]
+            })
+            .collect();
+        let sees = |&(_, _, n, d): &(usize, f64, DVec3, f64)| n.dot(eye) + d < 0.0;
+        let mut planes: Vec<(DVec3, f64)> = faces.iter().filter(|f| !sees(f)).map(|f| (f.2, f.3)).collect();
+        let size = (hi - lo).length() + (eye - (lo + hi) * 0.5).length();
+        for f in faces.iter().filter(|f| sees(f)) {
+            for g in faces.iter().filter(|g| g.0 != f.0 && !sees(g)) {
+                let k = 3 - f.0 - g.0;
+                let mut q = (lo + hi) * 0.5;
+                (q[f.0], q[g.0]) = (f.1, g.1);
+                let mut n = DVec3::AXES[k].cross(eye - q);
+                if corners.iter().map(|&c| n.dot(c - eye)).sum::<f64>() < 0.0 {
+                    n = -n;
+                }
+                let tolerance = 1e-9 * n.length() * size;
+                if n.length() > 0.0 && corners.iter().all(|&c| n.dot(c - eye) >= -tolerance) {
+                    planes.push((n, -n.dot(eye)));
+                }
+            }
+        }
+        SightHull { planes }
+    }
+
+    /// Cuts `verts` (homogeneous) to the hull in place; `scratch` is scratch. Fewer than
+    /// three vertices left means nothing of it is inside.
+    pub(crate) fn clip(&self, verts: &mut Vec<DVec4>, scratch: &mut Vec<DVec4>) {
+        for &(n, d) in &self.planes {
+            crate::geometry::clip_in_place(verts, scratch, |h: DVec4| n.dot(h.truncate()) + d * h.w);
+            if verts.len() < 3 {
+                return;
+            }
+        }
+    }
+}
+
 /// One light sample's shadow polygons in screen space, with their outlines.
 pub struct ScreenVolumes {
     /// The polygons.
@@ -537,7 +601,30 @@ impl ScreenVolumes {
         let view = ctx.view;
         let mut out = ScreenVolumes { polys: Vec::new(), rings: Vec::new() };
         let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
+        // Z-pass counts between the eye and the visible point: its sides are cut to the hull
+        // of the two. The margin keeps every visible point well inside it.
+        let hull = match counting {
+            Counting::ZFail => None,
+            Counting::ZPass | Counting::NaiveZPass => {
+                let margin = 1e-6 * (ctx.extent + (view.eye.length()));
+                ctx.scene.bounds().map(|b| SightHull::new(b, margin, view.eye))
+            }
+        };
+        let (mut cut, mut cut_scratch, mut outside) = (Vec::new(), Vec::new(), 0u64);
         for sp in shadow_polygons(ctx, adjacency, sample, counting, counters) {
+            let verts = match &hull {
+                Some(hull) if sp.part == Part::Side => {
+                    cut.clear();
+                    cut.extend_from_slice(&sp.verts);
+                    hull.clip(&mut cut, &mut cut_scratch);
+                    if cut.len() < 3 {
+                        outside += 1;
+                        continue;
+                    }
+                    &cut
+                }
+                _ => &sp.verts,
+            };
             // A back cap lies on the plane at infinity: inverse depth 0, behind everything.
             let depth = match &sp.plane {
                 Some(plane) => match view.depth_plane(plane) {
@@ -551,7 +638,7 @@ impl ScreenVolumes {
                 // would let rounding throw it away).
                 ring.clear();
                 ring.extend(sp.verts.iter().map(|&v| view.project(view.to_camera(v.truncate()))));
-            } else if !view.clip_project_homogeneous(&sp.verts, &mut scratch, &mut ring) {
+            } else if !view.clip_project_homogeneous(verts, &mut scratch, &mut ring) {
                 continue;
             }
             out.rings.push(ring.clone());
@@ -564,6 +651,7 @@ impl ScreenVolumes {
             });
         }
         counters.add("screen_shadow_polygons", out.polys.len() as u64);
+        counters.add("sides_outside_sight", outside);
         out
     }
 }
