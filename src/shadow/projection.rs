@@ -60,14 +60,7 @@ impl Projector {
             let ds = plane.distance(s);
             self.clip(|x| (ds - plane.distance(x)) * side);
         }
-        let center = rect.iter().sum::<DVec3>() / 4.0;
-        for k in 0..4 {
-            let (q0, q1) = (rect[k], rect[(k + 1) % 4]);
-            let (origin, m) = match sample {
-                LightSample::Point(s) => (s, (q0 - s).cross(q1 - s)),
-                LightSample::Directional(d) => (q0, (q1 - q0).cross(d)),
-            };
-            let m = if m.dot(center - origin) >= 0.0 { m } else { -m };
+        for (origin, m) in pyramid(rect, sample) {
             self.clip(|x| m.dot(x - origin));
         }
         if self.shadow.is_empty() {
@@ -82,6 +75,12 @@ impl Projector {
         let area2 = newell_normal(&self.shadow).length();
         let size = rect[0].distance(rect[2]);
         area2 > 1e-12 * size * size && self.shadow.iter().all(|x| x.is_finite())
+    }
+
+    /// Whether polygon `verts` lies wholly outside one face of `pyramid` (from [`pyramid`]):
+    /// then [`Projector::project`] would find nothing, and need not be asked.
+    pub fn misses(verts: &[DVec3], pyramid: &[(DVec3, DVec3); 4]) -> bool {
+        pyramid.iter().any(|&(origin, m)| verts.iter().all(|&x| m.dot(x - origin) < 0.0))
     }
 
     fn clip(&mut self, dist: impl Fn(DVec3) -> f64) {
@@ -107,4 +106,18 @@ pub fn bounding_rectangle(verts: &[DVec3], plane: &Plane) -> [DVec3; 4] {
     let (lo, hi) = (lo - grow, hi + grow);
     let o = -plane.d * plane.n;
     [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].map(|c| o + c.x * u + c.y * v)
+}
+
+/// The four faces of the pyramid from a light sample over rectangle `rect` (a prism for a
+/// directional light), each as (a point on it, its inward normal).
+pub fn pyramid(rect: &[DVec3; 4], sample: LightSample) -> [(DVec3, DVec3); 4] {
+    let center = rect.iter().sum::<DVec3>() / 4.0;
+    std::array::from_fn(|k| {
+        let (q0, q1) = (rect[k], rect[(k + 1) % 4]);
+        let (origin, m) = match sample {
+            LightSample::Point(s) => (s, (q0 - s).cross(q1 - s)),
+            LightSample::Directional(d) => (q0, (q1 - q0).cross(d)),
+        };
+        (origin, if m.dot(center - origin) >= 0.0 { m } else { -m })
+    })
 }

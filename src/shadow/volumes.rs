@@ -43,7 +43,7 @@
 //! everything, so z-pass needs neither. Z-fail counts what lies behind the visible point, so
 //! it needs the sides and both caps, and no near caps. Naive z-pass leaves the near caps out.
 
-use super::projection::{edge_on, faces_away_on_solid, light_side, Projector};
+use super::projection::{edge_on, faces_away_on_solid, light_side, pyramid, Projector};
 use super::ShadowContext;
 use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane};
 use crate::pool::Stash;
@@ -125,7 +125,7 @@ pub fn shadow_polygons(
     counting: Counting,
     counters: &mut Counters,
 ) -> Vec<ShadowPolygon> {
-    let mut b = Builder::new(ctx, sample, counting);
+    let b = Builder::new(ctx, sample, counting);
     // With merged volumes, a closed solid's polygons turned away from the light are left out
     // (ours): every shadow ray crossing one has crossed, nearer the light, one of the same
     // solid turned toward it, so the counts change but never between zero and not zero.
@@ -136,38 +136,40 @@ pub fn shadow_polygons(
         .map(|i| !edge_on(ctx.scene, i, sample, ctx.extent) && !culled(i))
         .collect();
     let casts = |i: usize| casting[i];
-    // Step 1: the merged sides, one per edge whose net weight is not zero.
-    let (mut weight1, mut weight2) = (0u64, 0u64);
-    for e in &adjacency.edges {
-        let sharing = &adjacency.sharing[e.first as usize..(e.first + e.count) as usize];
-        let w = b.net_weight(e.a, e.b, sharing.iter().filter(|s| casts(s.poly as usize)));
-        if w != 0 {
-            b.push_side(e.a, e.b, w, None);
-            if w.abs() == 1 {
-                weight1 += 1;
-            } else {
-                weight2 += 1;
+    // Step 1: the merged sides, one per edge whose net weight is not zero. Each edge and
+    // each polygon is decided on its own, so they are worked out in parallel, in order.
+    let mut out: Vec<ShadowPolygon> = adjacency
+        .edges
+        .par_iter()
+        .filter_map(|e| {
+            let sharing = &adjacency.sharing[e.first as usize..(e.first + e.count) as usize];
+            if !sharing.iter().any(|s| casts(s.poly as usize)) {
+                return None; // no polygon on it casts: no side
             }
-        }
-    }
+            let w = b.net_weight(e.a, e.b, sharing.iter().filter(|s| casts(s.poly as usize)));
+            b.side(e.a, e.b, w, None)
+        })
+        .collect();
+    let weight1 = out.iter().filter(|p| p.sign.abs() == 1).count() as u64;
+    let weight2 = out.len() as u64 - weight1;
     // Step 2: the caps of every merged polygon.
-    for &p in adjacency.merged.iter().filter(|&&p| casts(p as usize)) {
-        b.push_caps(ctx.scene.verts(p as usize), p as usize, None);
-    }
+    let caps = adjacency
+        .merged
+        .par_iter()
+        .filter(|&&p| casts(p as usize))
+        .map_init(Projector::default, |proj, &p| b.caps(proj, ctx.scene.verts(p as usize), p as usize, None));
+    out.par_extend(caps.flat_map_iter(|c| c.into_iter().flatten()));
     // Step 3: the volumes kept apart, each with its own sides and caps.
+    let mut proj = Projector::default();
     for piece in adjacency.apart.iter().filter(|piece| casts(piece.poly as usize)) {
         let owner = Some(ctx.scene.polygons[piece.poly as usize].face);
         let v = &piece.verts;
         for k in 0..v.len() {
             let (a, c) = (v[k], v[(k + 1) % v.len()]);
-            let w = b.net_weight_one(a, c, piece.poly as usize);
-            if w != 0 {
-                b.push_side(a, c, w, owner);
-            }
+            out.extend(b.side(a, c, b.net_weight_one(a, c, piece.poly as usize), owner));
         }
-        b.push_caps(v, piece.poly as usize, owner);
+        out.extend(b.caps(&mut proj, v, piece.poly as usize, owner).into_iter().flatten());
     }
-    let out = b.out;
     counters.add("merged_edges", adjacency.edges.len() as u64);
     counters.add("polygons_apart", adjacency.apart.len() as u64);
     counters.add("sides_weight_1", weight1);
@@ -189,14 +191,15 @@ struct Builder<'c> {
     sample: LightSample,
     counting: Counting,
     near: (Plane, [DVec3; 4]),
-    proj: Projector,
-    out: Vec<ShadowPolygon>,
+    /// The pyramid from the light over the near rectangle: what misses it has no near cap.
+    near_pyramid: [(DVec3, DVec3); 4],
 }
 
 impl<'c> Builder<'c> {
     fn new(ctx: &'c ShadowContext<'c>, sample: LightSample, counting: Counting) -> Self {
         let near = ctx.view.near_rectangle();
-        Builder { ctx, sample, counting, near, proj: Projector::default(), out: Vec::new() }
+        let near_pyramid = pyramid(&near.1, sample);
+        Builder { ctx, sample, counting, near, near_pyramid }
     }
 
     /// The normal of the plane through edge `a → b` and the light (not normalised; zero when
@@ -238,72 +241,82 @@ impl<'c> Builder<'c> {
         self.orientation(self.edge_plane(a, b), a, b, poly)
     }
 
-    /// A side on edge `a → b` of weight `|w|`, facing out along the edge plane of `a → b`
-    /// times the sign of `w`.
-    fn push_side(&mut self, a: DVec3, b: DVec3, w: i32, owner: Option<u32>) {
+    /// The side on edge `a → b` of weight `|w|`, facing out along the edge plane of `a → b`
+    /// times the sign of `w`; none when `w` is zero or the light lies on the edge's line.
+    fn side(&self, a: DVec3, b: DVec3, w: i32, owner: Option<u32>) -> Option<ShadowPolygon> {
+        if w == 0 {
+            return None;
+        }
         let m = self.edge_plane(a, b) * w.signum() as f64;
         let n = m.normalize();
         if !n.is_finite() {
-            return; // the light lies on the edge's line: the side has no area
+            return None; // the light lies on the edge's line: the side has no area
         }
         let verts = match self.sample {
             LightSample::Point(_) => vec![finite(a), finite(b), self.away(b), self.away(a)],
             LightSample::Directional(_) => vec![finite(a), finite(b), self.away(a)],
         };
         let sign = self.eye_sign(n, a) * w.abs();
-        self.out.push(ShadowPolygon {
+        Some(ShadowPolygon {
             verts,
             plane: Some(Plane::new(n, a)),
             sign,
             part: Part::Side,
             lies_on: None,
             owner_face: owner,
-        });
+        })
     }
 
-    /// The caps of the volume of `verts` (on scene polygon `poly`) that `self.counting` needs.
-    fn push_caps(&mut self, verts: &[DVec3], poly: usize, owner: Option<u32>) {
+    /// The caps of the volume of `verts` (on scene polygon `poly`) that `self.counting` needs
+    /// (`proj` is scratch for the near cap).
+    fn caps(
+        &self,
+        proj: &mut Projector,
+        verts: &[DVec3],
+        poly: usize,
+        owner: Option<u32>,
+    ) -> [Option<ShadowPolygon>; 2] {
         let plane = self.ctx.scene.polygons[poly].plane;
         match self.counting {
             Counting::ZFail => {
                 let toward = plane.n * light_side(&plane, self.sample);
                 let sign = self.eye_sign(toward, verts[0]);
-                self.out.push(ShadowPolygon {
+                let front = ShadowPolygon {
                     verts: verts.iter().map(|&v| finite(v)).collect(),
                     plane: Some(plane),
                     sign,
                     part: Part::FrontCap,
                     lies_on: Some(poly as u32),
                     owner_face: owner,
-                });
+                };
                 // For a directional light every direction away is the same point at
                 // infinity: the sides close the volume there and no back cap is needed.
-                if let LightSample::Point(_) = self.sample {
-                    let verts = verts.iter().map(|&v| self.away(v)).collect();
-                    self.out.push(ShadowPolygon {
-                        verts,
-                        plane: None,
-                        sign: -1,
-                        part: Part::BackCap,
-                        lies_on: None,
-                        owner_face: owner,
-                    });
-                }
+                let back = matches!(self.sample, LightSample::Point(_)).then(|| ShadowPolygon {
+                    verts: verts.iter().map(|&v| self.away(v)).collect(),
+                    plane: None,
+                    sign: -1,
+                    part: Part::BackCap,
+                    lies_on: None,
+                    owner_face: owner,
+                });
+                [Some(front), back]
             }
             Counting::ZPass => {
                 let (near_plane, near_rect) = &self.near;
-                if self.proj.project(verts, near_plane, near_rect, self.sample) {
-                    self.out.push(ShadowPolygon {
-                        verts: self.proj.shadow.iter().map(|&v| finite(v)).collect(),
-                        plane: Some(*near_plane),
-                        sign: 1,
-                        part: Part::NearCap,
-                        lies_on: None,
-                        owner_face: owner,
-                    });
+                if Projector::misses(verts, &self.near_pyramid) {
+                    return [None, None];
                 }
+                let cap = proj.project(verts, near_plane, near_rect, self.sample).then(|| ShadowPolygon {
+                    verts: proj.shadow.iter().map(|&v| finite(v)).collect(),
+                    plane: Some(*near_plane),
+                    sign: 1,
+                    part: Part::NearCap,
+                    lies_on: None,
+                    owner_face: owner,
+                });
+                [cap, None]
             }
-            Counting::NaiveZPass => {}
+            Counting::NaiveZPass => [None, None],
         }
     }
 
