@@ -668,3 +668,69 @@ impl ScreenVolumes {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::SightHull;
+    use glam::{DVec3, DVec4};
+    use rand::{Rng, SeedableRng};
+
+    fn inside(hull: &SightHull, p: DVec3) -> f64 {
+        hull.planes.iter().map(|&(n, d)| (n.dot(p) + d) / n.length()).fold(f64::INFINITY, f64::min)
+    }
+
+    /// The hull holds the eye, the bounds and every sight line between them, and leaves out
+    /// what lies beyond the bounds as the eye sees them; wherever the eye is (outside, on a
+    /// face's plane, inside).
+    #[test]
+    fn the_sight_hull_holds_every_sight_line_and_not_what_lies_beyond() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut r = |a: f64, b: f64| rng.gen_range(a..b);
+        for case in 0..400 {
+            let lo = DVec3::new(r(-5.0, 5.0), r(-5.0, 5.0), r(-5.0, 5.0));
+            // Flat boxes too: a floor alone has no height.
+            let size = DVec3::new(r(0.0, 8.0), if case % 4 == 0 { 0.0 } else { r(0.0, 8.0) }, r(0.1, 8.0));
+            let hi = lo + size;
+            let mut eye = DVec3::new(r(-30.0, 30.0), r(-30.0, 30.0), r(-30.0, 30.0));
+            if case % 5 == 0 {
+                eye.y = hi.y; // on the plane of a face
+            }
+            let hull = SightHull::new((lo, hi), 1e-6 * 60.0, eye);
+            assert!(inside(&hull, eye) >= -1e-9, "case {case}: the eye is outside");
+            let in_box = |t: DVec3| lo + size * t;
+            for _ in 0..20 {
+                let p = in_box(DVec3::new(r(0.0, 1.0), r(0.0, 1.0), r(0.0, 1.0)));
+                let on_line = eye + (p - eye) * r(0.0, 1.0);
+                assert!(inside(&hull, p) > 0.0, "case {case}: a point of the bounds is outside");
+                assert!(inside(&hull, on_line) >= -1e-9, "case {case}: a sight line leaves the hull");
+            }
+            // Beyond the bounds from the eye: outside unless the eye is inside the bounds.
+            let centre = (lo + hi) * 0.5;
+            let beyond = centre + (centre - eye).normalize() * (size.length() + 1.0);
+            let eye_in = (eye.cmpge(lo) & eye.cmple(hi)).all();
+            assert!(eye_in || inside(&hull, beyond) < 0.0, "case {case}: a point beyond is inside");
+        }
+    }
+
+    /// A side hanging from an edge above a floor, lit from above, is cut where it goes
+    /// through the floor (and so where it passes out of sight).
+    #[test]
+    fn a_side_under_a_light_stops_at_the_floor() {
+        let hull = SightHull::new(
+            (DVec3::new(-10.0, 0.0, -10.0), DVec3::new(10.0, 2.0, 10.0)),
+            1e-6,
+            DVec3::new(0.0, 14.0, 17.0),
+        );
+        let light = DVec3::new(-16.0, 24.0, 6.0);
+        let (a, b) = (DVec3::new(0.0, 1.0, 0.0), DVec3::new(0.5, 1.0, 0.0));
+        let mut side = vec![a.extend(1.0), b.extend(1.0), (b - light).extend(0.0), (a - light).extend(0.0)];
+        hull.clip(&mut side, &mut Vec::new());
+        assert!(side.len() >= 3);
+        for h in &side {
+            assert!(h.w > 0.0, "a point at infinity is left: {h}");
+            let p = h.truncate() / h.w;
+            assert!(p.y >= -1e-5 && p.y <= 1.0 + 1e-9, "{p} lies outside the floor's slab");
+        }
+        assert!(side.iter().any(|h: &DVec4| (h.y / h.w).abs() < 1e-5), "it reaches the floor");
+    }
+}
