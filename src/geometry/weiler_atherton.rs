@@ -299,6 +299,13 @@ fn rings_that_meet(
     (oriented(&Region { rings: near }), oriented(&Region { rings: c_near }), far)
 }
 
+/// Whether the insides of `a` and `b` cannot overlap, found without clipping or allocating:
+/// the test [`clip`] makes before it traces ([`apart`]), for a caller to ask first and keep
+/// its pieces as they are.
+pub fn regions_apart(a: &Region, b: &Region) -> bool {
+    apart(&a.rings, &b.rings)
+}
+
 /// Whether a line separates the two sets of rings (touching counts: what they share has no
 /// area). The lines tried are those through the rings' edges: for two convex polygons (most
 /// meshes' triangles, and their neighbours in a light view) one of them separates whenever

@@ -27,7 +27,7 @@ use super::overlay::{CoverWalker, Overlay};
 use super::projection::{edge_on, faces_away_on_solid};
 use super::{ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
-use crate::geometry::weiler_atherton::{clip, ClipError, Region};
+use crate::geometry::weiler_atherton::{clip, regions_apart, ClipError, Region};
 use crate::geometry::{clip_in_place, clip_polygon, even_odd, grid_cells, Plane};
 use crate::scene::{LightSample, ObjText, Scene};
 use crate::stats::Counters;
@@ -183,7 +183,13 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
             .filter(|&q| {
                 let fresh = seen_stamp[q as usize] != fi;
                 seen_stamp[q as usize] = fi;
-                fresh && arena[q as usize].as_ref().is_some_and(|p| p.overlaps(&front))
+                // Pieces whose insides cannot meet the front polygon's (its neighbours on
+                // a mesh, which share only an edge) are not clipped: nothing of them is
+                // inside it.
+                fresh
+                    && arena[q as usize]
+                        .as_ref()
+                        .is_some_and(|p| p.overlaps(&front) && !regions_apart(&p.region, &front.region))
             })
             .collect();
         for q in candidates {
@@ -247,7 +253,7 @@ impl Ord for OrdF64 {
 /// lies in front of.
 fn unshadowed(o: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Result<Region, ClipError> {
     let mut lit = o.region.clone();
-    for s in seen.iter().filter(|s| s.overlaps(&o)) {
+    for s in seen.iter().filter(|s| s.overlaps(&o) && !regions_apart(&s.region, &o.region)) {
         stats.clips += 1;
         let c = clip(&lit, &s.region)?;
         lit = c.outside;
