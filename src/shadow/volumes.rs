@@ -535,8 +535,7 @@ impl ScreenShadowPolygon {
 /// bounds, so that segment lies in the hull, and the part of a side outside the hull is
 /// crossed by no such segment. Cutting the sides to the hull therefore changes no count,
 /// and a side no longer runs on screen from its edge to the image border: on a floor lit
-/// from above it stops at the floor. (Crow's sides, and Bergeron's, reach the limits of the
-/// environment; this is that limit, taken as tight as the eye allows.) Z-fail counts
+/// from above it stops at the floor. Z-fail counts
 /// behind P, out to infinity, so it keeps its sides whole.
 pub(crate) struct SightHull {
     /// Half-spaces `n · x + d · w >= 0` (homogeneous `x`, `w`) whose intersection holds the
