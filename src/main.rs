@@ -6,12 +6,6 @@ mod cli {
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-/// Frame-sized buffers are allocated and freed every frame; glibc's allocator returns them
-/// to the system each time and the next frame faults their pages in again (about a fifth of
-/// an s3 frame). mimalloc keeps them.
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 use cli::progress::TerminalBar;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -22,6 +16,12 @@ use umbra::study::compare::{compare, CompareOptions};
 use umbra::study::scale::{scale, ScaleOptions, Sweep};
 use umbra::ReflectionMethod;
 use umbra::{generate, Error, RenderOptions, Renderer, Scene, ShadowMethod, VisibilityMethod};
+
+/// Frame-sized buffers are allocated and freed every frame; glibc's allocator returns them
+/// to the system each time and the next frame faults their pages in again (about a fifth of
+/// an s3 frame). mimalloc keeps them.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 #[derive(Parser)]
 #[command(

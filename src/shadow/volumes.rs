@@ -535,8 +535,8 @@ impl ScreenShadowPolygon {
 /// bounds, so that segment lies in the hull, and the part of a side outside the hull is
 /// crossed by no such segment. Cutting the sides to the hull therefore changes no count,
 /// and a side no longer runs on screen from its edge to the image border: on a floor lit
-/// from above it stops at the floor. Z-fail counts
-/// behind P, out to infinity, so it keeps its sides whole.
+/// from above it stops at the floor. Z-fail counts behind P, out to infinity, so it keeps
+/// its sides whole.
 pub(crate) struct SightHull {
     /// Half-spaces `n · x + d · w >= 0` (homogeneous `x`, `w`) whose intersection holds the
     /// hull.
@@ -544,11 +544,14 @@ pub(crate) struct SightHull {
 }
 
 impl SightHull {
-    /// The hull of `eye` and the box `lo..hi` grown by `margin`: the faces of the box the eye
+    /// The hull of `eye` and the box `lo..hi` grown by a millionth of the size of the
+    /// coordinates involved (far above the clip's rounding): the faces of the box the eye
     /// does not see, and the planes through the eye and each box edge between a face it sees
     /// and one it does not. A plane that rounding leaves cutting the box is dropped (fewer
     /// planes only make the region larger, never wrong).
-    pub(crate) fn new((lo, hi): (DVec3, DVec3), margin: f64, eye: DVec3) -> Self {
+    pub(crate) fn new((lo, hi): (DVec3, DVec3), eye: DVec3) -> Self {
+        let reach = (hi - lo).length() + lo.abs().max(hi.abs()).max(eye.abs()).max_element();
+        let margin = 1e-6 * reach;
         let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
         let corners: Vec<DVec3> =
             (0..8).map(|k| DVec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2])).collect();
@@ -614,13 +617,10 @@ impl ScreenVolumes {
         let mut out = ScreenVolumes { polys: Vec::new(), rings: Vec::new() };
         let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
         // Z-pass counts between the eye and the visible point: its sides are cut to the hull
-        // of the two. The margin keeps every visible point well inside it.
+        // of the two.
         let hull = match counting {
             Counting::ZFail => None,
-            Counting::ZPass | Counting::NaiveZPass => {
-                let margin = 1e-6 * (ctx.extent + (view.eye.length()));
-                ctx.scene.bounds().map(|b| SightHull::new(b, margin, view.eye))
-            }
+            Counting::ZPass | Counting::NaiveZPass => ctx.scene.bounds().map(|b| SightHull::new(b, view.eye)),
         };
         let (mut cut, mut cut_scratch, mut outside) = (Vec::new(), Vec::new(), 0u64);
         for sp in shadow_polygons(ctx, adjacency, sample, counting, counters) {
@@ -694,7 +694,7 @@ mod tests {
             if case % 5 == 0 {
                 eye.y = hi.y; // on the plane of a face
             }
-            let hull = SightHull::new((lo, hi), 1e-6 * 60.0, eye);
+            let hull = SightHull::new((lo, hi), eye);
             assert!(inside(&hull, eye) >= -1e-9, "case {case}: the eye is outside");
             let in_box = |t: DVec3| lo + size * t;
             for _ in 0..20 {
@@ -715,21 +715,20 @@ mod tests {
     /// through the floor (and so where it passes out of sight).
     #[test]
     fn a_side_under_a_light_stops_at_the_floor() {
-        let hull = SightHull::new(
-            (DVec3::new(-10.0, 0.0, -10.0), DVec3::new(10.0, 2.0, 10.0)),
-            1e-6,
-            DVec3::new(0.0, 14.0, 17.0),
-        );
+        let hull =
+            SightHull::new((DVec3::new(-10.0, 0.0, -10.0), DVec3::new(10.0, 2.0, 10.0)), DVec3::new(0.0, 14.0, 17.0));
         let light = DVec3::new(-16.0, 24.0, 6.0);
         let (a, b) = (DVec3::new(0.0, 1.0, 0.0), DVec3::new(0.5, 1.0, 0.0));
         let mut side = vec![a.extend(1.0), b.extend(1.0), (b - light).extend(0.0), (a - light).extend(0.0)];
         hull.clip(&mut side, &mut Vec::new());
+        // The hull's margin: a millionth of the box's diagonal and farthest coordinate.
+        let margin = 1e-6 * ((DVec3::new(20.0, 2.0, 20.0)).length() + 17.0);
         assert!(side.len() >= 3);
         for h in &side {
             assert!(h.w > 0.0, "a point at infinity is left: {h}");
             let p = h.truncate() / h.w;
-            assert!(p.y >= -1e-5 && p.y <= 1.0 + 1e-9, "{p} lies outside the floor's slab");
+            assert!(p.y >= -1.01 * margin && p.y <= 1.0 + 1e-9, "{p} lies outside the floor's slab");
         }
-        assert!(side.iter().any(|h: &DVec4| (h.y / h.w).abs() < 1e-5), "it reaches the floor");
+        assert!(side.iter().any(|h: &DVec4| (h.y / h.w).abs() <= 1.01 * margin), "it reaches the floor");
     }
 }
