@@ -10,7 +10,10 @@
 //!    spherical coordinates with the azimuth's wrap-around handled). Pairs whose extents do
 //!    not overlap cannot shadow each other and are never projected. For a directional light
 //!    the "sphere" is the plane across the light's direction, and the extents are boxes there.
-//!    Pairs where A lies wholly behind B as seen from the light are dropped too.
+//!    Pairs where A lies wholly behind B as seen from the light are dropped too. A corner
+//!    that A shares with B lies on B's plane, whatever rounding makes of its distance: on a
+//!    closed mesh most candidate pairs are neighbours of this kind, and none of them is
+//!    projected.
 //! 3. **Projection.** Only the part of A between the light and B's plane can shadow B: A is
 //!    clipped by the plane through the light parallel to B and by B's plane, and also by the
 //!    pyramid from the light over B's bounding rectangle (what falls outside it cannot fall
@@ -33,7 +36,7 @@
 //! light; zero-area projections are dropped. None of these divide by zero.
 
 use super::overlay::{Interval, Overlay, OverlayWalker};
-use super::projection::{bounding_rectangle, edge_on, faces_away_on_solid, light_side, Projector};
+use super::projection::{bounding_rectangle, edge_on, faces_away_on_solid, light_side, Projector, Target};
 use super::{
     BouknightKelleyOptions, Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker,
 };
@@ -162,8 +165,9 @@ fn project_onto(
     let mut pairs = Pairs::default();
     let plane = scene.polygons[b as usize].plane;
     let side = light_side(&plane, sample);
-    let rect = bounding_rectangle(scene.verts(b as usize), &plane);
-    let wedge = Wedge::of(scene.verts(b as usize), sample, ctx.extent);
+    let b_verts = scene.verts(b as usize);
+    let target = Target::new(plane, bounding_rectangle(b_verts, &plane), sample);
+    let wedge = Wedge::of(b_verts, sample, ctx.extent);
     for a in candidates {
         if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
             continue;
@@ -172,14 +176,14 @@ fn project_onto(
         if record {
             pairs.kept.push(a);
         }
-        if scene.verts(a as usize).iter().all(|&v| plane.distance(v) * side <= 0.0) {
+        if scene.verts(a as usize).iter().all(|&v| plane.distance(v) * side <= 0.0 || b_verts.contains(&v)) {
             tally.behind += 1;
             if record {
                 pairs.behind.push(a);
             }
         } else if wedge.as_ref().is_some_and(|w| w.misses(scene.verts(a as usize))) {
             tally.outside += 1;
-        } else if !proj.project(scene.verts(a as usize), &plane, &rect, sample) {
+        } else if !proj.project(scene.verts(a as usize), &target) {
             tally.empty += 1;
         } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
             rings.push(ring.clone());

@@ -34,8 +34,47 @@ pub fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample) -> bool
     scene.turned_away_on_solid(i, sample)
 }
 
-/// Projects polygons from a light sample onto a bounded piece of a plane, keeping the scratch
-/// space between calls.
+/// A bounded piece of a plane that polygons are projected onto from one light sample: the
+/// plane, a rectangle of it, and the pyramid from the light over the rectangle (a prism for
+/// a directional light), worked out once for all the polygons projected onto it.
+#[derive(Debug, Clone)]
+pub struct Target {
+    /// The plane projected onto.
+    pub plane: Plane,
+    /// The rectangle of the plane that the shadows are kept within.
+    pub rect: [DVec3; 4],
+    sample: LightSample,
+    /// [`light_side`] of the plane.
+    side: f64,
+    /// The faces of the pyramid from the light over `rect`, each as (a point on it, its
+    /// inward normal).
+    pyramid: [(DVec3, DVec3); 4],
+}
+
+impl Target {
+    /// The rectangle `rect` of `plane`, lit by `sample`.
+    pub fn new(plane: Plane, rect: [DVec3; 4], sample: LightSample) -> Self {
+        let center = rect.iter().sum::<DVec3>() / 4.0;
+        let pyramid = std::array::from_fn(|k| {
+            let (q0, q1) = (rect[k], rect[(k + 1) % 4]);
+            let (origin, m) = match sample {
+                LightSample::Point(s) => (s, (q0 - s).cross(q1 - s)),
+                LightSample::Directional(d) => (q0, (q1 - q0).cross(d)),
+            };
+            (origin, if m.dot(center - origin) >= 0.0 { m } else { -m })
+        });
+        Target { plane, rect, sample, side: light_side(&plane, sample), pyramid }
+    }
+
+    /// Whether polygon `verts` lies wholly outside one face of the pyramid: then
+    /// [`Projector::project`] would find nothing, and need not be asked.
+    pub fn misses(&self, verts: &[DVec3]) -> bool {
+        self.pyramid.iter().any(|&(origin, m)| verts.iter().all(|&x| m.dot(x - origin) < 0.0))
+    }
+}
+
+/// Projects polygons from a light sample onto a [`Target`], keeping the scratch space
+/// between calls.
 #[derive(Debug, Default)]
 pub struct Projector {
     /// The last shadow made, in world space.
@@ -44,43 +83,36 @@ pub struct Projector {
 }
 
 impl Projector {
-    /// The shadow of polygon `verts` on `plane`, within the rectangle `rect` of that plane,
-    /// into `self.shadow` (world space). Only the part of the polygon between the light and
-    /// the plane can cast it: the polygon is clipped by the plane (keeping the light's side),
-    /// for a point light by the plane through the light parallel to it, and by the pyramid
-    /// (a prism for a directional light) from the light over `rect`, which keeps the
+    /// The shadow of polygon `verts` on `target`, into `self.shadow` (world space). Only the
+    /// part of the polygon between the light and the plane can cast it: the polygon is
+    /// clipped by the plane (keeping the light's side), for a point light by the plane
+    /// through the light parallel to it, and by the target's pyramid, which keeps the
     /// projection finite; then projected from the light onto the plane. `false` when nothing
     /// is left or the shadow has no area.
-    pub fn project(&mut self, verts: &[DVec3], plane: &Plane, rect: &[DVec3; 4], sample: LightSample) -> bool {
-        let side = light_side(plane, sample);
+    pub fn project(&mut self, verts: &[DVec3], target: &Target) -> bool {
+        let (plane, side) = (&target.plane, target.side);
         self.shadow.clear();
         self.shadow.extend_from_slice(verts);
         self.clip(|x| plane.distance(x) * side);
-        if let LightSample::Point(s) = sample {
+        if let LightSample::Point(s) = target.sample {
             let ds = plane.distance(s);
             self.clip(|x| (ds - plane.distance(x)) * side);
         }
-        for (origin, m) in pyramid(rect, sample) {
+        for &(origin, m) in &target.pyramid {
             self.clip(|x| m.dot(x - origin));
         }
         if self.shadow.is_empty() {
             return false;
         }
         for x in &mut self.shadow {
-            *x = match sample {
+            *x = match target.sample {
                 LightSample::Point(s) => s + (*x - s) * (-plane.distance(s) / plane.n.dot(*x - s)),
                 LightSample::Directional(d) => *x - d * (plane.distance(*x) / plane.n.dot(d)),
             };
         }
         let area2 = newell_normal(&self.shadow).length();
-        let size = rect[0].distance(rect[2]);
+        let size = target.rect[0].distance(target.rect[2]);
         area2 > 1e-12 * size * size && self.shadow.iter().all(|x| x.is_finite())
-    }
-
-    /// Whether polygon `verts` lies wholly outside one face of `pyramid` (from [`pyramid`]):
-    /// then [`Projector::project`] would find nothing, and need not be asked.
-    pub fn misses(verts: &[DVec3], pyramid: &[(DVec3, DVec3); 4]) -> bool {
-        pyramid.iter().any(|&(origin, m)| verts.iter().all(|&x| m.dot(x - origin) < 0.0))
     }
 
     fn clip(&mut self, dist: impl Fn(DVec3) -> f64) {
@@ -106,18 +138,4 @@ pub fn bounding_rectangle(verts: &[DVec3], plane: &Plane) -> [DVec3; 4] {
     let (lo, hi) = (lo - grow, hi + grow);
     let o = -plane.d * plane.n;
     [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].map(|c| o + c.x * u + c.y * v)
-}
-
-/// The four faces of the pyramid from a light sample over rectangle `rect` (a prism for a
-/// directional light), each as (a point on it, its inward normal).
-pub fn pyramid(rect: &[DVec3; 4], sample: LightSample) -> [(DVec3, DVec3); 4] {
-    let center = rect.iter().sum::<DVec3>() / 4.0;
-    std::array::from_fn(|k| {
-        let (q0, q1) = (rect[k], rect[(k + 1) % 4]);
-        let (origin, m) = match sample {
-            LightSample::Point(s) => (s, (q0 - s).cross(q1 - s)),
-            LightSample::Directional(d) => (q0, (q1 - q0).cross(d)),
-        };
-        (origin, if m.dot(center - origin) >= 0.0 { m } else { -m })
-    })
 }

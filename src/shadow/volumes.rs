@@ -43,7 +43,7 @@
 //! everything, so z-pass needs neither. Z-fail counts what lies behind the visible point, so
 //! it needs the sides and both caps, and no near caps. Naive z-pass leaves the near caps out.
 
-use super::projection::{edge_on, faces_away_on_solid, light_side, pyramid, Projector};
+use super::projection::{edge_on, faces_away_on_solid, light_side, Projector, Target};
 use super::ShadowContext;
 use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane};
 use crate::pool::Stash;
@@ -190,16 +190,14 @@ struct Builder<'c> {
     ctx: &'c ShadowContext<'c>,
     sample: LightSample,
     counting: Counting,
-    near: (Plane, [DVec3; 4]),
-    /// The pyramid from the light over the near rectangle: what misses it has no near cap.
-    near_pyramid: [(DVec3, DVec3); 4],
+    /// The near rectangle, for the near caps.
+    near: Target,
 }
 
 impl<'c> Builder<'c> {
     fn new(ctx: &'c ShadowContext<'c>, sample: LightSample, counting: Counting) -> Self {
-        let near = ctx.view.near_rectangle();
-        let near_pyramid = pyramid(&near.1, sample);
-        Builder { ctx, sample, counting, near, near_pyramid }
+        let (plane, rect) = ctx.view.near_rectangle();
+        Builder { ctx, sample, counting, near: Target::new(plane, rect, sample) }
     }
 
     /// The normal of the plane through edge `a → b` and the light (not normalised; zero when
@@ -302,13 +300,12 @@ impl<'c> Builder<'c> {
                 [Some(front), back]
             }
             Counting::ZPass => {
-                let (near_plane, near_rect) = &self.near;
-                if Projector::misses(verts, &self.near_pyramid) {
+                if self.near.misses(verts) {
                     return [None, None];
                 }
-                let cap = proj.project(verts, near_plane, near_rect, self.sample).then(|| ShadowPolygon {
+                let cap = proj.project(verts, &self.near).then(|| ShadowPolygon {
                     verts: proj.shadow.iter().map(|&v| finite(v)).collect(),
-                    plane: Some(*near_plane),
+                    plane: Some(self.near.plane),
                     sign: 1,
                     part: Part::NearCap,
                     lies_on: None,
