@@ -246,10 +246,12 @@ impl Tally {
 /// planes through the light and each of its edges, facing out. A caster wholly and strictly
 /// outside one of them is seen from the light beside the receiver, never over it: its
 /// shadow on the receiver's plane lies outside the receiver, so it is not projected. (The
-/// paper projects it onto the receiver's plane and finds the projection beside it.)
+/// paper projects it onto the receiver's plane and finds the projection beside it.) A corner
+/// of the receiver's edge lies on that edge's plane exactly, so a neighbour across the edge
+/// needs only its other corners outside.
 struct Wedge {
-    /// Each plane's unit normal (pointing out) and a point on it.
-    planes: [(DVec3, DVec3); 3],
+    /// Each plane's unit normal (pointing out) and the receiver's edge on it.
+    planes: [(DVec3, DVec3, DVec3); 3],
     /// How far outside a caster's corners must lie: rounding never decides a pair.
     margin: f64,
 }
@@ -265,15 +267,17 @@ impl Wedge {
             };
             let n = (q - p).cross(along).normalize_or_zero();
             let inside = n.dot(opposite - p);
-            (inside != 0.0 && n != DVec3::ZERO).then(|| (if inside > 0.0 { -n } else { n }, p))
+            (inside != 0.0 && n != DVec3::ZERO).then(|| (if inside > 0.0 { -n } else { n }, p, q))
         };
         let planes = [plane(*a, *b, *c)?, plane(*b, *c, *a)?, plane(*c, *a, *b)?];
         Some(Wedge { planes, margin: 1e-9 * extent })
     }
 
-    /// Whether every corner of `verts` lies outside one and the same plane of the wedge.
+    /// Whether every corner of `verts` lies outside one and the same plane of the wedge, or
+    /// is a corner of the receiver's edge on that plane (which lies on the plane exactly: a
+    /// neighbour across that edge is seen from the light beside the receiver too).
     fn misses(&self, verts: &[DVec3]) -> bool {
-        self.planes.iter().any(|&(n, p)| verts.iter().all(|&v| n.dot(v - p) > self.margin))
+        self.planes.iter().any(|&(n, p, q)| verts.iter().all(|&v| v == p || v == q || n.dot(v - p) > self.margin))
     }
 }
 

@@ -539,3 +539,40 @@ fn neighbours_behind_their_receiver_are_never_projected() {
         assert_eq!(c.get("shadow_polygons"), 0, "level {levels}");
     }
 }
+
+/// Bouknight-Kelley projects no pair of a fan of triangles in one plane (every pair shares
+/// the fan's centre): each neighbour of a receiver is dropped as behind or found beside it,
+/// outside the wedge from the light over the receiver, even when rounding puts its free
+/// corners a hair in front of the plane. A corner shared with the receiver is read as
+/// exactly on the plane and on the wedge's faces through it.
+#[test]
+fn neighbours_in_the_receivers_plane_are_never_projected() {
+    use glam::DVec3;
+    use umbra::scene::{Camera, Light, Material, Mesh, Object};
+    let (u, v) = (DVec3::new(0.93, 0.11, 0.17).normalize(), DVec3::new(-0.13, 0.07, 0.97).normalize());
+    let v = (v - u * u.dot(v)).normalize();
+    let centre = DVec3::new(0.13, 0.21, -0.07);
+    // Seven equal angles: every triangle fits beside each other one, within one face of
+    // its wedge, and no rim corner lies on another triangle's edge line.
+    let rim: Vec<DVec3> = (0..7)
+        .map(|k| {
+            let angle = 0.3 + k as f64 * std::f64::consts::TAU / 7.0;
+            centre + (u * angle.cos() + v * angle.sin()) * (1.3 + 0.17 * (k % 3) as f64)
+        })
+        .collect();
+    let polygons: Vec<Vec<DVec3>> = (0..7).map(|k| vec![centre, rim[k], rim[(k + 1) % 7]]).collect();
+    let camera = Camera { width: 64, height: 48, ..Camera::new(DVec3::new(0.4, 4.3, 3.9), centre) };
+    let scene = Scene::builder(camera)
+        .material(Material::new("m"))
+        .light(Light::point(DVec3::new(-0.7, 3.1, 0.9)))
+        .object(Object::new(Mesh::from_polygons(&polygons)), "m")
+        .build()
+        .unwrap();
+    let opts =
+        umbra::RenderOptions { shadows: ShadowMethod::BouknightKelley(Default::default()), ..Default::default() };
+    let c = umbra::render(&scene, &opts).unwrap().stats.shadow_counters;
+    assert_eq!(c.get("pairs_kept_by_prefilter"), 7 * 6);
+    assert!(c.get("pairs_outside_receiver") > 0, "no neighbour was found beside its receiver");
+    assert_eq!(c.get("projections_empty"), 0);
+    assert_eq!(c.get("shadow_polygons"), 0);
+}
