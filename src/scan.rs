@@ -19,6 +19,7 @@
 //! bit-identical crossings because the edge is always taken from its upper vertex.
 
 use glam::DVec2;
+use rayon::prelude::*;
 use std::ops::Range;
 
 /// Lines per band, when the lines of a frame are shared among threads in bands: enough bands
@@ -52,6 +53,15 @@ impl Edge {
         let (first, end) = (boundary(top.y, height), boundary(bot.y, height));
         let dxdy = (bot.x - top.x) / (bot.y - top.y);
         (first < end).then_some(Edge { x_top: top.x, y_top: top.y, dxdy, first, end, tag })
+    }
+
+    /// The edge, cut to `lines` when given; none when nothing of it is left.
+    fn within(tag: u32, a: DVec2, b: DVec2, height: u32, lines: &Option<Range<u32>>) -> Option<Edge> {
+        let mut e = Edge::new(tag, a, b, height)?;
+        if let Some(lines) = lines {
+            (e.first, e.end) = (e.first.max(lines.start), e.end.min(lines.end));
+        }
+        (e.first < e.end).then_some(e)
     }
 
     #[inline]
@@ -175,14 +185,25 @@ impl EdgeTable {
         self.built = false;
     }
 
+    /// Adds the rings of polygons `0..rings.len()` (ring `i` with tag `i`), their edges
+    /// worked out in parallel: the table is the one [`EdgeTable::add_ring`] would build
+    /// adding them in order.
+    pub fn add_rings(&mut self, rings: &[Vec<DVec2>]) {
+        let (height, within) = (self.height, &self.within);
+        let edges: Vec<Edge> = rings
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(tag, ring)| {
+                let from = ring.last().into_iter().chain(ring);
+                from.zip(ring).filter_map(move |(&a, &b)| Edge::within(tag as u32, a, b, height, within))
+            })
+            .collect();
+        self.edges.extend(edges);
+        self.built = false;
+    }
+
     fn add_edge(&mut self, tag: u32, a: DVec2, b: DVec2) {
-        if let Some(mut e) = Edge::new(tag, a, b, self.height) {
-            if let Some(lines) = &self.within {
-                (e.first, e.end) = (e.first.max(lines.start), e.end.min(lines.end));
-                if e.first >= e.end {
-                    return;
-                }
-            }
+        if let Some(e) = Edge::within(tag, a, b, self.height, &self.within) {
             self.edges.push(e);
         }
     }
@@ -643,6 +664,33 @@ mod tests {
             if took {
                 proptest::prop_assert_eq!(walked, table);
             }
+        }
+    }
+
+    /// The parallel `add_rings` builds the table `add_ring` builds ring by ring: the same
+    /// edges in the same order, cut to a band the same way.
+    #[test]
+    fn rings_added_in_parallel_make_the_same_table() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let rings: Vec<Vec<DVec2>> = (0..500)
+            .map(|_| {
+                let n = rng.gen_range(0..7);
+                (0..n).map(|_| DVec2::new(rng.gen_range(-10.0..90.0), rng.gen_range(-10.0..70.0))).collect()
+            })
+            .collect();
+        for band in [None, Some(13..41)] {
+            let (mut one, mut all) = (EdgeTable::new(60), EdgeTable::new(60));
+            if let Some(lines) = &band {
+                one.clear_to(60, lines.clone());
+                all.clear_to(60, lines.clone());
+            }
+            for (i, ring) in rings.iter().enumerate() {
+                one.add_ring(i as u32, ring);
+            }
+            all.add_rings(&rings);
+            assert!(one.len() > 1000, "{}", one.len());
+            assert!(one.edges().eq(all.edges()), "band {band:?}");
         }
     }
 

@@ -57,9 +57,7 @@ impl<'a> Crow<'a> {
             .map(|(_, _, sample)| {
                 let volumes = ScreenVolumes::new(ctx, &adjacency, sample, counting, counters);
                 let mut table = EdgeTable::new(view.height);
-                for (i, ring) in volumes.rings.iter().enumerate() {
-                    table.add_ring(i as u32, ring);
-                }
+                table.add_rings(&volumes.rings);
                 table.finish();
                 SampleVolumes { table, volumes }
             })

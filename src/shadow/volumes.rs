@@ -611,57 +611,90 @@ impl ScreenVolumes {
         counters: &mut Counters,
     ) -> Self {
         let view = ctx.view;
-        let mut out = ScreenVolumes { polys: Vec::new(), rings: Vec::new() };
-        let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
         // Z-pass counts between the eye and the visible point: its sides are cut to the hull
         // of the two.
         let hull = match counting {
             Counting::ZFail => None,
             Counting::ZPass | Counting::NaiveZPass => ctx.scene.bounds().map(|b| SightHull::new(b, view.eye)),
         };
-        let (mut cut, mut cut_scratch, mut outside) = (Vec::new(), Vec::new(), 0u64);
-        for sp in shadow_polygons(ctx, adjacency, sample, counting, counters) {
-            let verts = match &hull {
-                Some(hull) if sp.part == Part::Side => {
-                    cut.clear();
-                    cut.extend_from_slice(&sp.verts);
-                    hull.clip(&mut cut, &mut cut_scratch);
-                    if cut.len() < 3 {
-                        outside += 1;
-                        continue;
-                    }
-                    &cut
-                }
-                _ => &sp.verts,
-            };
-            // A back cap lies on the plane at infinity: inverse depth 0, behind everything.
-            let depth = match &sp.plane {
-                Some(plane) => match view.depth_plane(plane) {
-                    Some(d) => d,
-                    None => continue, // edge-on to the eye
-                },
-                None => DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
-            };
-            if sp.part == Part::NearCap {
-                // On the near plane by construction: projected as it is (clipping it there
-                // would let rounding throw it away).
-                ring.clear();
-                ring.extend(sp.verts.iter().map(|&v| view.project(view.to_camera(v.truncate()))));
-            } else if !view.clip_project_homogeneous(verts, &mut scratch, &mut ring) {
-                continue;
-            }
-            out.rings.push(ring.clone());
-            out.polys.push(ScreenShadowPolygon {
-                depth,
-                sign: sp.sign,
-                near_cap: sp.part == Part::NearCap,
-                lies_on: sp.lies_on.unwrap_or(NONE),
-                owner_face: sp.owner_face.unwrap_or(NONE),
-            });
-        }
+        // Each shadow polygon is put through the camera on its own: in parallel, in order.
+        let screen: Vec<Screened> = shadow_polygons(ctx, adjacency, sample, counting, counters)
+            .into_par_iter()
+            .map_init(Scratch::default, |scratch, sp| scratch.screen(view, hull.as_ref(), &sp))
+            .collect();
+        let outside = screen.iter().filter(|s| matches!(s, Screened::OutOfSight)).count() as u64;
+        let (polys, rings) = screen
+            .into_iter()
+            .filter_map(|s| match s {
+                Screened::On(poly, ring) => Some((poly, ring)),
+                _ => None,
+            })
+            .unzip();
+        let out = ScreenVolumes { polys, rings };
         counters.add("screen_shadow_polygons", out.polys.len() as u64);
         counters.add("sides_outside_sight", outside);
         out
+    }
+}
+
+/// What became of one shadow polygon put through the camera.
+enum Screened {
+    /// On screen: the polygon and its outline.
+    On(ScreenShadowPolygon, Vec<DVec2>),
+    /// A side wholly outside the sight hull.
+    OutOfSight,
+    /// Edge-on to the eye, or wholly behind the near plane.
+    Off,
+}
+
+/// One thread's scratch for putting shadow polygons through the camera.
+#[derive(Default)]
+struct Scratch {
+    cut: Vec<DVec4>,
+    cut_scratch: Vec<DVec4>,
+    clip: [Vec<DVec4>; 2],
+}
+
+impl Scratch {
+    /// Shadow polygon `sp` on screen: a side cut to `hull` first (z-pass), then clipped to
+    /// the near plane in homogeneous coordinates and projected.
+    fn screen(&mut self, view: &crate::view::View, hull: Option<&SightHull>, sp: &ShadowPolygon) -> Screened {
+        let verts = match hull {
+            Some(hull) if sp.part == Part::Side => {
+                self.cut.clear();
+                self.cut.extend_from_slice(&sp.verts);
+                hull.clip(&mut self.cut, &mut self.cut_scratch);
+                if self.cut.len() < 3 {
+                    return Screened::OutOfSight;
+                }
+                &self.cut
+            }
+            _ => &sp.verts,
+        };
+        // A back cap lies on the plane at infinity: inverse depth 0, behind everything.
+        let depth = match &sp.plane {
+            Some(plane) => match view.depth_plane(plane) {
+                Some(d) => d,
+                None => return Screened::Off, // edge-on to the eye
+            },
+            None => DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
+        };
+        let mut ring = Vec::new();
+        if sp.part == Part::NearCap {
+            // On the near plane by construction: projected as it is (clipping it there
+            // would let rounding throw it away).
+            ring.extend(sp.verts.iter().map(|&v| view.project(view.to_camera(v.truncate()))));
+        } else if !view.clip_project_homogeneous(verts, &mut self.clip, &mut ring) {
+            return Screened::Off;
+        }
+        let poly = ScreenShadowPolygon {
+            depth,
+            sign: sp.sign,
+            near_cap: sp.part == Part::NearCap,
+            lies_on: sp.lies_on.unwrap_or(NONE),
+            owner_face: sp.owner_face.unwrap_or(NONE),
+        };
+        Screened::On(poly, ring)
     }
 }
 
