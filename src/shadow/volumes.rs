@@ -42,6 +42,10 @@
 //! are scene polygons (never in front of a visible point) and the back caps lie beyond
 //! everything, so z-pass needs neither. Z-fail counts what lies behind the visible point, so
 //! it needs the sides and both caps, and no near caps. Naive z-pass leaves the near caps out.
+//!
+//! Two cuts are ours: z-pass's sides are cut to the hull of the eye and the scene's bounds
+//! ([`SightHull`]), and z-fail's volumes are closed at a plane beyond the scene, with *far
+//! caps* there instead of back caps at infinity, where there is such a plane ([`FarPlane`]).
 
 use super::projection::{edge_on, faces_away_on_solid, light_side, Projector, Target};
 use super::ShadowContext;
@@ -95,6 +99,8 @@ pub enum Part {
     BackCap,
     /// The volume's cross-section with the near plane.
     NearCap,
+    /// The volume's cross-section with the far plane that closes z-fail's volumes (ours).
+    FarCap,
 }
 
 /// One shadow polygon in world space.
@@ -179,6 +185,7 @@ pub fn shadow_polygons(
         (Part::FrontCap, "shadow_polygons_front_cap"),
         (Part::BackCap, "shadow_polygons_back_cap"),
         (Part::NearCap, "shadow_polygons_near_cap"),
+        (Part::FarCap, "shadow_polygons_far_cap"),
     ] {
         counters.add(name, out.iter().filter(|p| p.part == part).count() as u64);
     }
@@ -192,12 +199,19 @@ struct Builder<'c> {
     counting: Counting,
     /// The near rectangle, for the near caps.
     near: Target,
+    /// Z-fail's far plane and the part of it behind the scene, for the far caps (none:
+    /// back caps at infinity).
+    far: Option<Target>,
 }
 
 impl<'c> Builder<'c> {
     fn new(ctx: &'c ShadowContext<'c>, sample: LightSample, counting: Counting) -> Self {
         let (plane, rect) = ctx.view.near_rectangle();
-        Builder { ctx, sample, counting, near: Target::new(plane, rect, sample) }
+        let far = match counting {
+            Counting::ZFail => FarPlane::of(ctx).map(|f| Target::new(f.plane, f.rect, sample)),
+            Counting::ZPass | Counting::NaiveZPass => None,
+        };
+        Builder { ctx, sample, counting, near: Target::new(plane, rect, sample), far }
     }
 
     /// The normal of the plane through edge `a → b` and the light (not normalised; zero when
@@ -287,16 +301,28 @@ impl<'c> Builder<'c> {
                     lies_on: Some(poly as u32),
                     owner_face: owner,
                 };
-                // For a directional light every direction away is the same point at
-                // infinity: the sides close the volume there and no back cap is needed.
-                let back = matches!(self.sample, LightSample::Point(_)).then(|| ShadowPolygon {
-                    verts: verts.iter().map(|&v| self.away(v)).collect(),
-                    plane: None,
-                    sign: -1,
-                    part: Part::BackCap,
-                    lies_on: None,
-                    owner_face: owner,
-                });
+                let back = match &self.far {
+                    // Closed at the far plane: the volume's cross-section there, which
+                    // every count behind a visible point starts from.
+                    Some(far) => proj.project(verts, far).then(|| ShadowPolygon {
+                        verts: proj.shadow.iter().map(|&v| finite(v)).collect(),
+                        plane: Some(far.plane),
+                        sign: -1,
+                        part: Part::FarCap,
+                        lies_on: None,
+                        owner_face: owner,
+                    }),
+                    // For a directional light every direction away is the same point at
+                    // infinity: the sides close the volume there and no back cap is needed.
+                    None => matches!(self.sample, LightSample::Point(_)).then(|| ShadowPolygon {
+                        verts: verts.iter().map(|&v| self.away(v)).collect(),
+                        plane: None,
+                        sign: -1,
+                        part: Part::BackCap,
+                        lies_on: None,
+                        owner_face: owner,
+                    }),
+                };
                 [Some(front), back]
             }
             Counting::ZPass => {
@@ -526,6 +552,77 @@ impl ScreenShadowPolygon {
     }
 }
 
+/// The far plane that closes z-fail's volumes (ours): a face of the scene's bounds, grown by
+/// a margin, that every sight line crosses beyond every point of the bounds. Z-fail counts a
+/// visible point P from infinity; the sight line beyond P crosses the far plane once, at Q,
+/// so P's count is Q's count (the volumes holding Q: the far caps, each volume's
+/// cross-section with the plane, found by projecting its front cap from the light) plus
+/// the shadow polygons crossed between P and Q. The sides are cut at the plane and the
+/// back caps at infinity are not needed: on a floor lit from above, a side stops at the
+/// floor instead of running down the screen to its vanishing point. It mirrors the near
+/// caps that z-pass starts from (Bergeron 1986).
+struct FarPlane {
+    /// The plane, its normal pointing back into the bounds (toward the eye).
+    plane: Plane,
+    /// A rectangle of it holding every point a sight line through the bounds meets.
+    rect: [DVec3; 4],
+}
+
+impl FarPlane {
+    /// The face of the bounds (grown as [`SightHull`]'s are) that faces away from the
+    /// light the most among those the eye lies beyond the opposite face of (so that every
+    /// sight line through the bounds goes on to cross it); none when the eye is within the
+    /// bounds' slab along every axis.
+    fn of(ctx: &ShadowContext) -> Option<FarPlane> {
+        let samples: Vec<LightSample> = ctx.scene.lights.iter().flat_map(|l| l.samples()).collect();
+        FarPlane::new(ctx.scene.bounds()?, ctx.view.eye, &samples)
+    }
+
+    /// The far plane of bounds `lo..hi` seen from `eye`, lit by `samples`.
+    fn new((lo, hi): (DVec3, DVec3), eye: DVec3, samples: &[LightSample]) -> Option<FarPlane> {
+        let margin = sight_margin((lo, hi), eye);
+        let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
+        let centre = (lo + hi) * 0.5;
+        let away = |n: DVec3| {
+            let along = |s: &LightSample| match *s {
+                LightSample::Point(p) => n.dot((centre - p).normalize_or_zero()),
+                LightSample::Directional(d) => n.dot(d),
+            };
+            samples.iter().map(along).fold(-1.0, f64::max)
+        };
+        // Each face as (axis, its coordinate, its outward normal), when the eye lies beyond
+        // the opposite face.
+        let faces = (0..3).flat_map(|i| {
+            let e = DVec3::AXES[i];
+            [(i, lo[i], -e, eye[i] > hi[i]), (i, hi[i], e, eye[i] < lo[i])]
+        });
+        let (axis, at, out, _) = faces.filter(|f| f.3).max_by(|a, b| away(a.2).total_cmp(&away(b.2)))?;
+        // Every sight line through the bounds meets the plane within the hull of the
+        // corners' shadows from the eye on it.
+        let corners = (0..8).map(|k| DVec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2]));
+        let (mut a, mut b) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for c in corners {
+            let q = eye + (c - eye) * ((at - eye[axis]) / (c[axis] - eye[axis]));
+            (a, b) = (a.min(q), b.max(q));
+        }
+        let grow = (b - a).max_element() * 1e-9 + margin;
+        let (a, b) = (a - DVec3::splat(grow), b + DVec3::splat(grow));
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        let rect = [(a[u], a[v]), (b[u], a[v]), (b[u], b[v]), (a[u], b[v])].map(|(x, y)| {
+            let mut p = DVec3::ZERO;
+            (p[axis], p[u], p[v]) = (at, x, y);
+            p
+        });
+        Some(FarPlane { plane: Plane::new(-out, rect[0]), rect })
+    }
+}
+
+/// The margin the bounds are grown by for the cuts: a millionth of the size of the
+/// coordinates involved (far above the clip's rounding).
+fn sight_margin((lo, hi): (DVec3, DVec3), eye: DVec3) -> f64 {
+    1e-6 * ((hi - lo).length() + lo.abs().max(hi.abs()).max(eye.abs()).max_element())
+}
+
 /// The region every sight line z-pass counts along stays in (ours): the convex hull of the
 /// eye and the scene's bounds, grown by a margin. A z-pass count at a visible point P sums
 /// the shadow polygons crossed between the eye (its near point) and P; P lies in the
@@ -547,8 +644,7 @@ impl SightHull {
     /// and one it does not. A plane that rounding leaves cutting the box is dropped (fewer
     /// planes only make the region larger, never wrong).
     pub(crate) fn new((lo, hi): (DVec3, DVec3), eye: DVec3) -> Self {
-        let reach = (hi - lo).length() + lo.abs().max(hi.abs()).max(eye.abs()).max_element();
-        let margin = 1e-6 * reach;
+        let margin = sight_margin((lo, hi), eye);
         let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
         let corners: Vec<DVec3> =
             (0..8).map(|k| DVec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2])).collect();
@@ -612,9 +708,10 @@ impl ScreenVolumes {
     ) -> Self {
         let view = ctx.view;
         // Z-pass counts between the eye and the visible point: its sides are cut to the hull
-        // of the two.
+        // of the two. Z-fail, closed at a far plane, counts between the visible point and
+        // that plane: its sides are cut there.
         let hull = match counting {
-            Counting::ZFail => None,
+            Counting::ZFail => FarPlane::of(ctx).map(|f| SightHull { planes: vec![(f.plane.n, f.plane.d)] }),
             Counting::ZPass | Counting::NaiveZPass => ctx.scene.bounds().map(|b| SightHull::new(b, view.eye)),
         };
         // Each shadow polygon is put through the camera on its own: in parallel, in order.
@@ -700,7 +797,8 @@ impl Scratch {
 
 #[cfg(test)]
 mod tests {
-    use super::SightHull;
+    use super::{FarPlane, SightHull};
+    use crate::scene::LightSample;
     use glam::{DVec3, DVec4};
     use rand::{Rng, SeedableRng};
 
@@ -739,6 +837,51 @@ mod tests {
             let eye_in = (eye.cmpge(lo) & eye.cmple(hi)).all();
             assert!(eye_in || inside(&hull, beyond) < 0.0, "case {case}: a point beyond is inside");
         }
+    }
+
+    /// Z-fail's far plane lies beyond the bounds on every sight line: for random boxes and
+    /// eyes outside them, the line from the eye through any point of the box crosses the
+    /// plane beyond the point, inside the plane's rectangle; an eye within the box's slabs
+    /// gets none; a light overhead picks the floor's face.
+    #[test]
+    fn every_sight_line_through_the_bounds_crosses_the_far_plane_beyond_them() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut r = |a: f64, b: f64| rng.gen_range(a..b);
+        let mut found = 0;
+        for case in 0..400 {
+            let lo = DVec3::new(r(-5.0, 5.0), r(-5.0, 5.0), r(-5.0, 5.0));
+            let size = DVec3::new(r(0.0, 8.0), if case % 4 == 0 { 0.0 } else { r(0.0, 8.0) }, r(0.1, 8.0));
+            let hi = lo + size;
+            let eye = DVec3::new(r(-30.0, 30.0), r(-30.0, 30.0), r(-30.0, 30.0));
+            let light = [LightSample::Point(DVec3::new(r(-30.0, 30.0), r(-30.0, 30.0), r(-30.0, 30.0)))];
+            let Some(far) = FarPlane::new((lo, hi), eye, &light) else {
+                let margin = 1e-3;
+                assert!(
+                    (0..3).all(|i| eye[i] >= lo[i] - margin && eye[i] <= hi[i] + margin),
+                    "case {case}: no far plane"
+                );
+                continue;
+            };
+            found += 1;
+            let (rlo, rhi) =
+                far.rect.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &c| (a.min(c), b.max(c)));
+            for _ in 0..20 {
+                let p = lo + size * DVec3::new(r(0.0, 1.0), r(0.0, 1.0), r(0.0, 1.0));
+                let (dp, de) = (far.plane.distance(p), far.plane.distance(eye));
+                assert!(dp > 0.0 && de > dp, "case {case}: the box or the eye is not on the plane's inner side");
+                let q = eye + (p - eye) * (de / (de - dp));
+                assert!(
+                    q.cmpge(rlo - DVec3::splat(1e-9)).all() && q.cmple(rhi + DVec3::splat(1e-9)).all(),
+                    "case {case}: {q} is outside the rectangle"
+                );
+            }
+        }
+        assert!(found > 300, "{found}");
+        let (lo, hi) = (DVec3::new(-10.0, 0.0, -10.0), DVec3::new(10.0, 2.0, 10.0));
+        let overhead = [LightSample::Point(DVec3::new(-16.0, 24.0, 6.0))];
+        assert!(FarPlane::new((lo, hi), DVec3::new(0.0, 1.0, 0.0), &overhead).is_none());
+        let far = FarPlane::new((lo, hi), DVec3::new(0.0, 14.0, 17.0), &overhead).unwrap();
+        assert!(far.plane.n.y > 0.99 && far.rect.iter().all(|c| c.y < 0.0 && c.y > -1e-3), "{:?}", far.rect);
     }
 
     /// A side hanging from an edge above a floor, lit from above, is cut where it goes

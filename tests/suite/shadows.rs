@@ -576,3 +576,27 @@ fn neighbours_in_the_receivers_plane_are_never_projected() {
     assert_eq!(c.get("projections_empty"), 0);
     assert_eq!(c.get("shadow_polygons"), 0);
 }
+
+/// Z-fail's volumes are closed at a far plane where every sight line through the scene's
+/// bounds crosses one face of them (the generated scenes, seen from above), and at infinity
+/// where the eye is within the bounds (a robustness scene, the eye inside a box): both
+/// closings are at work in
+/// the exact checks, and both give ray-cast's light here.
+#[test]
+fn zfail_closes_its_volumes_at_a_far_plane_or_at_infinity() {
+    use umbra::shadow::{Counting, VolumeOptions};
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let room = Scene::load(dir.join("tests/data/robustness/eye_inside_box.toml")).unwrap();
+    let spheres = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
+    for (scene, far) in [(&spheres, true), (&room, false)] {
+        for method in [ShadowMethod::Crow, ShadowMethod::StencilVolume] {
+            let m = method(VolumeOptions { counting: Counting::ZFail, ..VolumeOptions::default() });
+            let opts = umbra::RenderOptions { shadows: m.clone(), ..Default::default() };
+            let out = umbra::render(scene, &opts).unwrap();
+            let c = &out.stats.shadow_counters;
+            let (far_caps, back_caps) = (c.get("shadow_polygons_far_cap"), c.get("shadow_polygons_back_cap"));
+            assert_eq!((far_caps > 0, back_caps > 0), (far, !far), "far caps {far_caps}, back caps {back_caps}");
+            assert_light_agree(scene, &reference(scene), &out.frame, &format!("{m:?} closed far: {far}"));
+        }
+    }
+}
