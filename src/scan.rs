@@ -198,7 +198,11 @@ impl EdgeTable {
                 from.zip(ring).filter_map(move |(&a, &b)| Edge::within(tag as u32, a, b, height, within))
             })
             .collect();
-        self.edges.extend(edges);
+        if self.edges.is_empty() {
+            self.edges = edges;
+        } else {
+            self.edges.extend(edges);
+        }
         self.built = false;
     }
 
