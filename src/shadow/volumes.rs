@@ -124,14 +124,15 @@ pub struct ShadowPolygon {
 }
 
 /// The shadow polygons of one light sample for a count taken by `counting`.
-pub fn shadow_polygons(
+fn shadow_polygons(
     ctx: &ShadowContext,
     adjacency: &Adjacency,
     sample: LightSample,
     counting: Counting,
+    far: Option<&FarPlane>,
     counters: &mut Counters,
 ) -> Vec<ShadowPolygon> {
-    let b = Builder::new(ctx, sample, counting);
+    let b = Builder::new(ctx, sample, counting, far);
     // With merged volumes, a closed solid's polygons turned away from the light are left out
     // (ours): every shadow ray crossing one has crossed, nearer the light, one of the same
     // solid turned toward it, so the counts change but never between zero and not zero.
@@ -205,12 +206,9 @@ struct Builder<'c> {
 }
 
 impl<'c> Builder<'c> {
-    fn new(ctx: &'c ShadowContext<'c>, sample: LightSample, counting: Counting) -> Self {
+    fn new(ctx: &'c ShadowContext<'c>, sample: LightSample, counting: Counting, far: Option<&FarPlane>) -> Self {
         let (plane, rect) = ctx.view.near_rectangle();
-        let far = match counting {
-            Counting::ZFail => FarPlane::of(ctx).map(|f| Target::new(f.plane, f.rect, sample)),
-            Counting::ZPass | Counting::NaiveZPass => None,
-        };
+        let far = far.map(|f| Target::new(f.plane, f.rect, sample));
         Builder { ctx, sample, counting, near: Target::new(plane, rect, sample), far }
     }
 
@@ -710,12 +708,16 @@ impl ScreenVolumes {
         // Z-pass counts between the eye and the visible point: its sides are cut to the hull
         // of the two. Z-fail, closed at a far plane, counts between the visible point and
         // that plane: its sides are cut there.
+        let far = match counting {
+            Counting::ZFail => FarPlane::of(ctx),
+            Counting::ZPass | Counting::NaiveZPass => None,
+        };
         let hull = match counting {
-            Counting::ZFail => FarPlane::of(ctx).map(|f| SightHull { planes: vec![(f.plane.n, f.plane.d)] }),
+            Counting::ZFail => far.as_ref().map(|f| SightHull { planes: vec![(f.plane.n, f.plane.d)] }),
             Counting::ZPass | Counting::NaiveZPass => ctx.scene.bounds().map(|b| SightHull::new(b, view.eye)),
         };
         // Each shadow polygon is put through the camera on its own: in parallel, in order.
-        let screen: Vec<Screened> = shadow_polygons(ctx, adjacency, sample, counting, counters)
+        let screen: Vec<Screened> = shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), counters)
             .into_par_iter()
             .map_init(Scratch::default, |scratch, sp| scratch.screen(view, hull.as_ref(), &sp))
             .collect();
