@@ -5,7 +5,6 @@ mod cli {
 }
 
 use clap::{Parser, Subcommand, ValueEnum};
-
 use cli::progress::TerminalBar;
 use std::path::PathBuf;
 use std::process::ExitCode;

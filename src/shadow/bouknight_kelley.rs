@@ -176,14 +176,15 @@ fn project_onto(
         if record {
             pairs.kept.push(a);
         }
-        if scene.verts(a as usize).iter().all(|&v| plane.distance(v) * side <= 0.0 || b_verts.contains(&v)) {
+        let a_verts = scene.verts(a as usize);
+        if a_verts.iter().all(|&v| plane.distance(v) * side <= 0.0 || b_verts.contains(&v)) {
             tally.behind += 1;
             if record {
                 pairs.behind.push(a);
             }
-        } else if wedge.as_ref().is_some_and(|w| w.misses(scene.verts(a as usize))) {
+        } else if wedge.as_ref().is_some_and(|w| w.misses(a_verts)) {
             tally.outside += 1;
-        } else if !proj.project(scene.verts(a as usize), &target) {
+        } else if !proj.project(a_verts, &target) {
             tally.empty += 1;
         } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
             rings.push(ring.clone());

@@ -568,25 +568,14 @@ struct FarPlane {
 
 impl FarPlane {
     /// The face of the bounds (grown as [`SightHull`]'s are) that faces away from the
-    /// light the most among those the eye lies beyond the opposite face of (so that every
-    /// sight line through the bounds goes on to cross it); none when the eye is within the
-    /// bounds' slab along every axis.
-    fn of(ctx: &ShadowContext) -> Option<FarPlane> {
-        let samples: Vec<LightSample> = ctx.scene.lights.iter().flat_map(|l| l.samples()).collect();
-        FarPlane::new(ctx.scene.bounds()?, ctx.view.eye, &samples)
-    }
-
-    /// The far plane of bounds `lo..hi` seen from `eye`, lit by `samples`.
-    fn new((lo, hi): (DVec3, DVec3), eye: DVec3, samples: &[LightSample]) -> Option<FarPlane> {
-        let margin = sight_margin((lo, hi), eye);
-        let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
-        let centre = (lo + hi) * 0.5;
-        let away = |n: DVec3| {
-            let along = |s: &LightSample| match *s {
-                LightSample::Point(p) => n.dot((centre - p).normalize_or_zero()),
-                LightSample::Directional(d) => n.dot(d),
-            };
-            samples.iter().map(along).fold(-1.0, f64::max)
+    /// light sample the most among those the eye lies beyond the opposite face of (so that
+    /// every sight line through the bounds goes on to cross it); none when the eye is
+    /// within the bounds' slab along every axis.
+    fn new(bounds: (DVec3, DVec3), eye: DVec3, sample: LightSample) -> Option<FarPlane> {
+        let (lo, hi) = grown(bounds, eye);
+        let away = match sample {
+            LightSample::Point(p) => ((lo + hi) * 0.5 - p).normalize_or_zero(),
+            LightSample::Directional(d) => d,
         };
         // Each face as (axis, its coordinate, its outward normal), when the eye lies beyond
         // the opposite face.
@@ -594,16 +583,15 @@ impl FarPlane {
             let e = DVec3::AXES[i];
             [(i, lo[i], -e, eye[i] > hi[i]), (i, hi[i], e, eye[i] < lo[i])]
         });
-        let (axis, at, out, _) = faces.filter(|f| f.3).max_by(|a, b| away(a.2).total_cmp(&away(b.2)))?;
+        let (axis, at, out, _) = faces.filter(|f| f.3).max_by(|f, g| f.2.dot(away).total_cmp(&g.2.dot(away)))?;
         // Every sight line through the bounds meets the plane within the hull of the
         // corners' shadows from the eye on it.
-        let corners = (0..8).map(|k| DVec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2]));
         let (mut a, mut b) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for c in corners {
+        for c in corners(lo, hi) {
             let q = eye + (c - eye) * ((at - eye[axis]) / (c[axis] - eye[axis]));
             (a, b) = (a.min(q), b.max(q));
         }
-        let grow = (b - a).max_element() * 1e-9 + margin;
+        let grow = (b - a).max_element() * 1e-9 + margin(bounds, eye);
         let (a, b) = (a - DVec3::splat(grow), b + DVec3::splat(grow));
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
         let rect = [(a[u], a[v]), (b[u], a[v]), (b[u], b[v]), (a[u], b[v])].map(|(x, y)| {
@@ -615,20 +603,32 @@ impl FarPlane {
     }
 }
 
-/// The margin the bounds are grown by for the cuts: a millionth of the size of the
-/// coordinates involved (far above the clip's rounding).
-fn sight_margin((lo, hi): (DVec3, DVec3), eye: DVec3) -> f64 {
+/// The bounds `lo..hi` grown, for the cuts, by a millionth of the size of the coordinates
+/// involved (box and eye: far above the clip's rounding).
+fn grown((lo, hi): (DVec3, DVec3), eye: DVec3) -> (DVec3, DVec3) {
+    let margin = margin((lo, hi), eye);
+    (lo - DVec3::splat(margin), hi + DVec3::splat(margin))
+}
+
+/// What [`grown`] grows the bounds by.
+fn margin((lo, hi): (DVec3, DVec3), eye: DVec3) -> f64 {
     1e-6 * ((hi - lo).length() + lo.abs().max(hi.abs()).max(eye.abs()).max_element())
 }
 
-/// The region every sight line z-pass counts along stays in (ours): the convex hull of the
-/// eye and the scene's bounds, grown by a margin. A z-pass count at a visible point P sums
-/// the shadow polygons crossed between the eye (its near point) and P; P lies in the
-/// bounds, so that segment lies in the hull, and the part of a side outside the hull is
-/// crossed by no such segment. Cutting the sides to the hull therefore changes no count,
-/// and a side no longer runs on screen from its edge to the image border: on a floor lit
-/// from above it stops at the floor. Z-fail counts behind P, out to infinity, so it keeps
-/// its sides whole.
+/// The eight corners of the box `lo..hi`.
+fn corners(lo: DVec3, hi: DVec3) -> [DVec3; 8] {
+    std::array::from_fn(|k| DVec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2]))
+}
+
+/// The region every sight line a count follows stays in (ours), which the sides are cut to.
+/// For z-pass, the convex hull of the eye and the scene's bounds, grown by a margin: a
+/// z-pass count at a visible point P sums the shadow polygons crossed between the eye (its
+/// near point) and P; P lies in the bounds, so that segment lies in the hull, and the part
+/// of a side outside the hull is crossed by no such segment. Cutting the sides to the hull
+/// therefore changes no count, and a side no longer runs on screen from its edge to the
+/// image border: on a floor lit from above it stops at the floor. For z-fail closed at a
+/// far plane ([`FarPlane`]), the plane's inner side, where the count from P to the plane
+/// is taken.
 pub(crate) struct SightHull {
     /// Half-spaces `n · x + d · w >= 0` (homogeneous `x`, `w`) whose intersection holds the
     /// hull.
@@ -641,11 +641,9 @@ impl SightHull {
     /// does not see, and the planes through the eye and each box edge between a face it sees
     /// and one it does not. A plane that rounding leaves cutting the box is dropped (fewer
     /// planes only make the region larger, never wrong).
-    pub(crate) fn new((lo, hi): (DVec3, DVec3), eye: DVec3) -> Self {
-        let margin = sight_margin((lo, hi), eye);
-        let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
-        let corners: Vec<DVec3> =
-            (0..8).map(|k| DVec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2])).collect();
+    pub(crate) fn new(bounds: (DVec3, DVec3), eye: DVec3) -> Self {
+        let (lo, hi) = grown(bounds, eye);
+        let corners = corners(lo, hi);
         // The six faces, inward: (axis, coordinate, inward normal, offset).
         let faces: Vec<(usize, f64, DVec3, f64)> = (0..3)
             .flat_map(|i| {
@@ -672,6 +670,11 @@ impl SightHull {
             }
         }
         SightHull { planes }
+    }
+
+    /// Z-fail's region: the inner side of its far plane.
+    fn before(far: &FarPlane) -> Self {
+        SightHull { planes: vec![(far.plane.n, far.plane.d)] }
     }
 
     /// Cuts `verts` (homogeneous) to the hull in place; `scratch` is scratch. Fewer than
@@ -708,13 +711,14 @@ impl ScreenVolumes {
         // Z-pass counts between the eye and the visible point: its sides are cut to the hull
         // of the two. Z-fail, closed at a far plane, counts between the visible point and
         // that plane: its sides are cut there.
-        let far = match counting {
-            Counting::ZFail => FarPlane::of(ctx),
-            Counting::ZPass | Counting::NaiveZPass => None,
-        };
-        let hull = match counting {
-            Counting::ZFail => far.as_ref().map(|f| SightHull { planes: vec![(f.plane.n, f.plane.d)] }),
-            Counting::ZPass | Counting::NaiveZPass => ctx.scene.bounds().map(|b| SightHull::new(b, view.eye)),
+        let bounds = ctx.scene.bounds();
+        let (far, hull) = match counting {
+            Counting::ZFail => {
+                let far = bounds.and_then(|b| FarPlane::new(b, view.eye, sample));
+                let hull = far.as_ref().map(SightHull::before);
+                (far, hull)
+            }
+            Counting::ZPass | Counting::NaiveZPass => (None, bounds.map(|b| SightHull::new(b, view.eye))),
         };
         // Each shadow polygon is put through the camera on its own: in parallel, in order.
         let screen: Vec<Screened> = shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), counters)
@@ -755,8 +759,8 @@ struct Scratch {
 }
 
 impl Scratch {
-    /// Shadow polygon `sp` on screen: a side cut to `hull` first (z-pass), then clipped to
-    /// the near plane in homogeneous coordinates and projected.
+    /// Shadow polygon `sp` on screen: a side cut to `hull` first, then clipped to the near
+    /// plane in homogeneous coordinates and projected.
     fn screen(&mut self, view: &crate::view::View, hull: Option<&SightHull>, sp: &ShadowPolygon) -> Screened {
         let verts = match hull {
             Some(hull) if sp.part == Part::Side => {
@@ -855,8 +859,8 @@ mod tests {
             let size = DVec3::new(r(0.0, 8.0), if case % 4 == 0 { 0.0 } else { r(0.0, 8.0) }, r(0.1, 8.0));
             let hi = lo + size;
             let eye = DVec3::new(r(-30.0, 30.0), r(-30.0, 30.0), r(-30.0, 30.0));
-            let light = [LightSample::Point(DVec3::new(r(-30.0, 30.0), r(-30.0, 30.0), r(-30.0, 30.0)))];
-            let Some(far) = FarPlane::new((lo, hi), eye, &light) else {
+            let light = LightSample::Point(DVec3::new(r(-30.0, 30.0), r(-30.0, 30.0), r(-30.0, 30.0)));
+            let Some(far) = FarPlane::new((lo, hi), eye, light) else {
                 let margin = 1e-3;
                 assert!(
                     (0..3).all(|i| eye[i] >= lo[i] - margin && eye[i] <= hi[i] + margin),
@@ -880,9 +884,9 @@ mod tests {
         }
         assert!(found > 300, "{found}");
         let (lo, hi) = (DVec3::new(-10.0, 0.0, -10.0), DVec3::new(10.0, 2.0, 10.0));
-        let overhead = [LightSample::Point(DVec3::new(-16.0, 24.0, 6.0))];
-        assert!(FarPlane::new((lo, hi), DVec3::new(0.0, 1.0, 0.0), &overhead).is_none());
-        let far = FarPlane::new((lo, hi), DVec3::new(0.0, 14.0, 17.0), &overhead).unwrap();
+        let overhead = LightSample::Point(DVec3::new(-16.0, 24.0, 6.0));
+        assert!(FarPlane::new((lo, hi), DVec3::new(0.0, 1.0, 0.0), overhead).is_none());
+        let far = FarPlane::new((lo, hi), DVec3::new(0.0, 14.0, 17.0), overhead).unwrap();
         assert!(far.plane.n.y > 0.99 && far.rect.iter().all(|c| c.y < 0.0 && c.y > -1e-3), "{:?}", far.rect);
     }
 
