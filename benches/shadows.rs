@@ -40,7 +40,7 @@ fn stages(c: &mut Criterion) {
             ("ray-cast", ShadowMethod::RayCast),
         ];
         if *name != "sphere100k" {
-            methods.push(("atherton-weiler-greenberg", ShadowMethod::AthertonWeilerGreenberg));
+            methods.push(("atherton-weiler-greenberg", ShadowMethod::AthertonWeilerGreenberg(Default::default())));
             methods.push((
                 "bouknight-kelley-no-prefilter",
                 ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false, ..Default::default() }),
@@ -61,10 +61,11 @@ fn atherton_weiler_greenberg(c: &mut Criterion) {
         ("sphere10k", generate::spheres(10_000, 1, W, H).unwrap()),
     ] {
         g.bench_function(BenchmarkId::new("pass1", name), |b| {
-            b.iter(|| ShadowDatabase::build(&scene, 0, &mut Counters::default()).unwrap())
+            b.iter(|| ShadowDatabase::build(&scene, 0, Default::default(), &mut Counters::default()).unwrap())
         });
-        let db = Arc::new(vec![ShadowDatabase::build(&scene, 0, &mut Counters::default()).unwrap()]);
-        let view_pass = opts(ShadowMethod::AthertonWeilerGreenberg);
+        let db =
+            Arc::new(vec![ShadowDatabase::build(&scene, 0, Default::default(), &mut Counters::default()).unwrap()]);
+        let view_pass = opts(ShadowMethod::AthertonWeilerGreenberg(Default::default()));
         let mut renderer = Renderer::new().with_shadow_database(db.clone());
         g.bench_function(BenchmarkId::new("view-pass", name), |b| {
             b.iter(|| renderer.render(&scene, &view_pass).unwrap().stats.polygons)

@@ -10,9 +10,13 @@ fn main() -> umbra::Result<()> {
     let (scene_path, out) = (&args[1], std::path::Path::new(&args[2]));
     let mut scene = Scene::load(scene_path)?;
     let mut counters = Counters::default();
-    let db = Arc::new(vec![ShadowDatabase::build(&scene, 0, &mut counters)?]);
+    let db = Arc::new(vec![ShadowDatabase::build(&scene, 0, Default::default(), &mut counters)?]);
     println!("{}", serde_json::to_string(&counters).unwrap_or_default());
-    let opts = RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg, outlines: true, ..Default::default() };
+    let opts = RenderOptions {
+        shadows: ShadowMethod::AthertonWeilerGreenberg(Default::default()),
+        outlines: true,
+        ..Default::default()
+    };
     let mut renderer = Renderer::new().with_shadow_database(db);
     std::fs::create_dir_all(out).map_err(|e| umbra::Error::Io { path: out.to_owned(), source: e })?;
     for (name, eye) in [("awg-detail", scene.camera().eye), ("awg-second-view", glam::DVec3::new(2.2, 4.8, 2.6))] {

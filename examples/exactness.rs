@@ -20,7 +20,7 @@ fn main() {
         let volumes = |counting| VolumeOptions { counting, ..VolumeOptions::default() };
         let stages = [
             ("bk", ShadowMethod::DEFAULT),
-            ("awg", ShadowMethod::AthertonWeilerGreenberg),
+            ("awg", ShadowMethod::AthertonWeilerGreenberg(Default::default())),
             ("crow-zpass", ShadowMethod::Crow(volumes(Counting::ZPass))),
             ("crow-zfail", ShadowMethod::Crow(volumes(Counting::ZFail))),
             ("stencil-zpass", ShadowMethod::StencilVolume(volumes(Counting::ZPass))),

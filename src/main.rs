@@ -10,7 +10,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use umbra::shadow::Counting;
-use umbra::shadow::{BouknightKelleyOptions, ShadowFilter, VolumeOptions, WilliamsOptions};
+use umbra::shadow::{
+    AthertonWeilerGreenbergOptions, BouknightKelleyOptions, ShadowFilter, VolumeOptions, WilliamsOptions,
+};
 use umbra::study::compare::{compare, CompareOptions};
 use umbra::study::scale::{scale, ScaleOptions, Sweep};
 use umbra::ReflectionMethod;
@@ -81,6 +83,11 @@ struct ShadowArgs {
     /// as casters, as the paper does (to measure what dropping them saves).
     #[arg(long)]
     no_solid_cull: bool,
+    /// Atherton-Weiler-Greenberg: clip every pair of pieces in the light view with Weiler
+    /// and Atherton's clipper, as the paper does, instead of splitting convex pieces by each
+    /// other's edges (to measure what splitting saves).
+    #[arg(long)]
+    no_convex_split: bool,
     /// Crow and stencil-volume: count shadow volumes from the eye with the eye's own count
     /// (zpass), from infinity (zfail), or from zero at the eye (naive-zpass, wrong when the
     /// eye is in shadow).
@@ -167,6 +174,7 @@ impl ShadowArgs {
                 prefilter: !self.no_prefilter,
                 solid_cull: !self.no_solid_cull,
             }),
+            ShadowMethod::AthertonWeilerGreenberg(_) => ShadowMethod::AthertonWeilerGreenberg(self.awg()),
             ShadowMethod::Crow(_) => ShadowMethod::Crow(volumes),
             ShadowMethod::StencilVolume(_) => ShadowMethod::StencilVolume(volumes),
             ShadowMethod::Williams(_) => ShadowMethod::Williams(WilliamsOptions {
@@ -181,6 +189,11 @@ impl ShadowArgs {
             }),
             other => other,
         }
+    }
+
+    /// Atherton-Weiler-Greenberg's settings from these flags.
+    fn awg(&self) -> AthertonWeilerGreenbergOptions {
+        AthertonWeilerGreenbergOptions { convex_split: !self.no_convex_split }
     }
 
     /// Every method of `methods` configured by these flags.
@@ -480,6 +493,10 @@ struct ExportArgs {
     /// Overwrite the OBJ file if it exists.
     #[arg(long)]
     force: bool,
+    /// Clip every pair of pieces in the light view with Weiler and Atherton's clipper, as
+    /// the paper does, instead of splitting convex pieces by each other's edges.
+    #[arg(long)]
+    no_convex_split: bool,
 }
 
 fn parse<T: std::str::FromStr<Err = Error>>(s: &str) -> Result<T, String> {
@@ -515,7 +532,7 @@ fn render_command(a: RenderArgs) -> umbra::Result<()> {
     let drawn = matches!(
         a.shadows,
         ShadowMethod::BouknightKelley(_)
-            | ShadowMethod::AthertonWeilerGreenberg
+            | ShadowMethod::AthertonWeilerGreenberg(_)
             | ShadowMethod::Crow(_)
             | ShadowMethod::Planar
     );
@@ -690,7 +707,8 @@ fn export_shadows_command(e: ExportArgs) -> umbra::Result<()> {
     }
     refuse_overwrite(std::slice::from_ref(&e.output), e.force)?;
     let mut counters = umbra::Counters::default();
-    let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, &mut counters)?;
+    let options = AthertonWeilerGreenbergOptions { convex_split: !e.no_convex_split };
+    let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, options, &mut counters)?;
     db.write_obj(&scene, &e.output)?;
     let polygons: usize = db.samples.iter().map(Vec::len).sum();
     say(&format!("wrote {}: {polygons} lit detail polygon(s) of light {}", e.output.display(), e.light))

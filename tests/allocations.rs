@@ -56,7 +56,7 @@ fn a_renderer_allocates_no_frame_sized_buffer_after_its_first_frame() {
         (VisibilityMethod::Scanline, ShadowMethod::BouknightKelley(Default::default()), 20),
         (VisibilityMethod::Scanline, ShadowMethod::Crow(Default::default()), 20),
         (VisibilityMethod::ZBuffer, ShadowMethod::Williams(Default::default()), 20),
-        (VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg, 20),
+        (VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg(Default::default()), 20),
         (VisibilityMethod::ZBuffer, ShadowMethod::StencilVolume(Default::default()), 20),
         (VisibilityMethod::Scanline, ShadowMethod::RayCast, 20),
     ];

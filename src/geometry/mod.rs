@@ -1,7 +1,9 @@
 //! Planar polygons in f64: Newell normals, planes, the planarity and degeneracy rules of
 //! `docs/scene-format.md` section 2, clipping by a plane, point-in-polygon by the even-odd rule,
-//! and Weiler-Atherton polygon clipping ([`weiler_atherton`]).
+//! Weiler-Atherton polygon clipping ([`weiler_atherton`]), and its shortcut for two convex
+//! polygons ([`convex_split`]).
 
+pub mod convex_split;
 pub mod even_odd;
 pub mod weiler_atherton;
 

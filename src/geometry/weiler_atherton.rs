@@ -82,6 +82,7 @@ impl Region {
     }
 
     /// Whether it has no rings.
+    #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.rings.is_empty()
     }

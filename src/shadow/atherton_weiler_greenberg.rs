@@ -25,9 +25,10 @@
 
 use super::overlay::{CoverWalker, Overlay};
 use super::projection::{edge_on, faces_away_on_solid};
-use super::{ShadowContext, ShadowStage, ShadowWalker};
+use super::{AthertonWeilerGreenbergOptions, ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
-use crate::geometry::weiler_atherton::{clip, regions_apart, ClipError, Region};
+use crate::geometry::convex_split::{self, is_convex};
+use crate::geometry::weiler_atherton::{clip, regions_apart, ClipError, Region, Ring};
 use crate::geometry::{clip_in_place, clip_polygon, even_odd, grid_cells, Plane};
 use crate::scene::{LightSample, ObjText, Scene};
 use crate::stats::Counters;
@@ -63,12 +64,22 @@ struct Piece {
     region: Region,
     near: DepthPlane,
     bounds: (DVec2, DVec2),
+    /// Whether the region is one convex ring (then [`cut`] splits it by edges).
+    convex: bool,
 }
 
 impl Piece {
     fn new(source: u32, region: Region, near: DepthPlane) -> Option<Piece> {
         let bounds = region.bounds()?;
-        Some(Piece { source, region, near, bounds })
+        let convex = region.rings.len() == 1 && is_convex(&region.rings[0]);
+        Some(Piece { source, region, near, bounds, convex })
+    }
+
+    /// A piece known to be one convex ring.
+    fn convex(source: u32, ring: Ring, near: DepthPlane) -> Option<Piece> {
+        let region = Region::from_ring(ring);
+        let bounds = region.bounds()?;
+        Some(Piece { source, region, near, bounds, convex: true })
     }
 
     fn overlaps(&self, other: &Piece) -> bool {
@@ -82,9 +93,11 @@ impl Piece {
     }
 }
 
-/// Counters of pass 1.
+/// Pass 1's setting and counters.
 #[derive(Debug, Default)]
 struct Pass1 {
+    /// Split convex pieces by edges ([`AthertonWeilerGreenbergOptions::convex_split`]).
+    convex_split: bool,
     fragments: u64,
     clips: u64,
     depth_max: u64,
@@ -93,6 +106,10 @@ struct Pass1 {
 }
 
 impl Pass1 {
+    fn new(options: AthertonWeilerGreenbergOptions) -> Pass1 {
+        Pass1 { convex_split: options.convex_split, ..Default::default() }
+    }
+
     fn add(&mut self, o: &Pass1) {
         self.fragments += o.fragments;
         self.clips += o.clips;
@@ -132,6 +149,17 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
     let (a, b) = (&q.near, &clip_piece.near);
     let (da, db, dc) = (a.a - b.a, a.b - b.b, a.c - b.c);
     let (lo, hi) = q.bounds;
+    if q.convex && stats.convex_split {
+        // A convex piece is cut by the line directly.
+        stats.splits += 1;
+        let norm = DVec2::new(da, db).length();
+        if norm == 0.0 {
+            return Ok((dc > 0.0).then(|| q.clone()));
+        }
+        let eps = 1e-9 * (hi - lo).length().max(1e-300);
+        let (front, _) = convex_split::cut(&q.region.rings[0], |p| (da * p.x + db * p.y + dc) / norm, eps);
+        return Ok(front.and_then(|r| Piece::convex(q.source, r, q.near)));
+    }
     let pad = (hi - lo).max_element().max(1e-12);
     let (lo, hi) = (lo - DVec2::splat(pad), hi + DVec2::splat(pad));
     let rect = [DVec2::new(lo.x, lo.y), DVec2::new(hi.x, lo.y), DVec2::new(hi.x, hi.y), DVec2::new(lo.x, hi.y)];
@@ -146,6 +174,27 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
     Ok(Piece::new(q.source, c.inside, q.near))
 }
 
+/// A piece's parts inside and outside another.
+type Parts = (Vec<Piece>, Vec<Piece>);
+
+/// `q` cut by the outline of `by`: its parts inside `by` and outside it. Two convex pieces
+/// are split by `by`'s edges ([`convex_split`], ours: the outside part comes as convex
+/// pieces); any other pair goes through Weiler and Atherton's clipper.
+fn cut(q: &Piece, by: &Piece, stats: &mut Pass1) -> std::result::Result<Parts, ClipError> {
+    stats.clips += 1;
+    if q.convex && by.convex && stats.convex_split {
+        let s = convex_split::split(&q.region.rings[0], &by.region.rings[0]);
+        let piece = |r| Piece::convex(q.source, r, q.near);
+        return Ok((
+            s.inside.into_iter().filter_map(piece).collect(),
+            s.outside.into_iter().filter_map(piece).collect(),
+        ));
+    }
+    let c = clip(&q.region, &by.region)?;
+    let piece = |r| Piece::new(q.source, r, q.near);
+    Ok((piece(c.inside).into_iter().collect(), piece(c.outside).into_iter().collect()))
+}
+
 /// Weiler & Atherton's hidden-surface removal by area sorting: the parts of `list` that
 /// nothing in the list hides.
 ///
@@ -154,52 +203,27 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
 /// the front polygon meets only the pieces it may overlap.
 fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
     stats.depth_max = stats.depth_max.max(depth);
-    let Some((lo, hi)) = list.iter().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else {
-        return Ok(Vec::new());
-    };
-    let g = ((list.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
-    let size = (hi - lo).max(DVec2::splat(1e-300));
-    let cells_of = |b: (DVec2, DVec2)| grid_cells(lo, size, g, b).map(move |(c, r)| c * g + r);
-    let mut grid: Vec<Vec<u32>> = vec![Vec::new(); g * g];
-    let mut arena: Vec<Option<Piece>> = Vec::new();
-    let mut heap = std::collections::BinaryHeap::new();
+    let Some(mut sort) = Sorting::new(&list) else { return Ok(Vec::new()) };
     for p in list {
-        let i = arena.len() as u32;
-        for c in cells_of(p.bounds) {
-            grid[c].push(i);
-        }
-        // Max-heap: nearest first, then first added.
-        heap.push((OrdF64(p.nearest()), std::cmp::Reverse(i)));
-        arena.push(Some(p));
+        let key = OrdF64(p.nearest());
+        sort.add(p, key);
     }
     let mut out = Vec::new();
-    let mut seen_stamp: Vec<u32> = vec![u32::MAX; arena.len()];
-    while let Some((_, std::cmp::Reverse(fi))) = heap.pop() {
-        let Some(front) = arena[fi as usize].take() else { continue };
+    while let Some((_, std::cmp::Reverse(fi))) = sort.heap.pop() {
+        let Some(front) = sort.arena[fi as usize].take() else { continue };
         // The front polygon's outline splits everything it overlaps into inside and outside.
         let mut inside = Vec::new();
-        let candidates: Vec<u32> = cells_of(front.bounds)
-            .flat_map(|c| grid[c].iter().copied())
-            .filter(|&q| {
-                let fresh = seen_stamp[q as usize] != fi;
-                seen_stamp[q as usize] = fi;
-                // Pieces whose insides cannot meet the front polygon's (its neighbours on
-                // a mesh, which share only an edge) are not clipped: nothing of them is
-                // inside it.
-                fresh
-                    && arena[q as usize]
-                        .as_ref()
-                        .is_some_and(|p| p.overlaps(&front) && !regions_apart(&p.region, &front.region))
-            })
-            .collect();
-        for q in candidates {
-            let Some(piece) = arena[q as usize].take() else { continue };
-            stats.clips += 1;
-            let c = clip(&piece.region, &front.region)?;
-            inside.extend(Piece::new(piece.source, c.inside, piece.near));
+        for q in sort.overlapping(&front, fi) {
+            let Some(piece) = sort.arena[q as usize].take() else { continue };
+            let (ins, outs) = cut(&piece, &front, stats)?;
+            inside.extend(ins);
             // The outside part takes its parent's place: in the grid (it only shrank) and in
-            // the order.
-            arena[q as usize] = Piece::new(piece.source, c.outside, piece.near);
+            // the order; further pieces of it join both at the same place in the order.
+            let mut outs = outs.into_iter();
+            sort.arena[q as usize] = outs.next();
+            for p in outs {
+                sort.add(p, sort.keys[q as usize]);
+            }
         }
         // Inside: hidden where behind the front polygon; where in front, the sort was wrong.
         let mut fronts = Vec::new();
@@ -216,19 +240,104 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
         }
         // Resolve what is in front first, then keep the front polygon where none of it is.
         let seen = visible(fronts, depth + 1, stats)?;
-        let mut remains = front.region.clone();
-        for s in &seen {
-            stats.clips += 1;
-            remains = clip(&remains, &s.region)?.outside;
-            if remains.is_empty() {
-                break;
-            }
-        }
+        let remains = outside_all(front, &seen, stats)?;
         out.extend(seen);
-        out.extend(Piece::new(front.source, remains, front.near));
+        out.extend(remains);
     }
     stats.fragments += out.len() as u64;
     Ok(out)
+}
+
+/// What is left of `piece` outside every piece of `by`.
+fn outside_all(piece: Piece, by: &[Piece], stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
+    let mut remains = vec![piece];
+    for s in by {
+        let mut next = Vec::with_capacity(remains.len());
+        for r in remains {
+            if r.overlaps(s) {
+                next.extend(cut(&r, s, stats)?.1);
+            } else {
+                next.push(r);
+            }
+        }
+        remains = next;
+        if remains.is_empty() {
+            break;
+        }
+    }
+    Ok(remains)
+}
+
+/// The pieces of one area sort: each in an arena slot (empty once taken), in a uniform grid
+/// over their bounding boxes, and in a heap by their key (rough depth order).
+struct Sorting {
+    arena: Vec<Option<Piece>>,
+    keys: Vec<OrdF64>,
+    heap: std::collections::BinaryHeap<(OrdF64, std::cmp::Reverse<u32>)>,
+    grid: Vec<Vec<u32>>,
+    /// `stamp[q]`: the last front polygon piece `q` was found for.
+    stamp: Vec<u32>,
+    lo: DVec2,
+    size: DVec2,
+    g: usize,
+}
+
+impl Sorting {
+    /// An empty sort over the bounds of `list` (`None` when `list` is empty).
+    fn new(list: &[Piece]) -> Option<Sorting> {
+        let (lo, hi) = list.iter().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))?;
+        let g = ((list.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
+        let size = (hi - lo).max(DVec2::splat(1e-300));
+        let n = list.len();
+        Some(Sorting {
+            arena: Vec::with_capacity(n),
+            keys: Vec::with_capacity(n),
+            heap: std::collections::BinaryHeap::with_capacity(n),
+            grid: vec![Vec::new(); g * g],
+            stamp: Vec::with_capacity(n),
+            lo,
+            size,
+            g,
+        })
+    }
+
+    fn cells(&self, b: (DVec2, DVec2)) -> impl Iterator<Item = usize> {
+        let g = self.g;
+        grid_cells(self.lo, self.size, g, b).map(move |(c, r)| c * g + r)
+    }
+
+    /// Adds `p` with sort key `key` (nearest first, then first added).
+    fn add(&mut self, p: Piece, key: OrdF64) {
+        let i = self.arena.len() as u32;
+        for c in self.cells(p.bounds).collect::<smallvec::SmallVec<[usize; 8]>>() {
+            self.grid[c].push(i);
+        }
+        self.heap.push((key, std::cmp::Reverse(i)));
+        self.keys.push(key);
+        self.stamp.push(u32::MAX);
+        self.arena.push(Some(p));
+    }
+
+    /// The pieces still waiting whose insides may meet `front`'s (front polygon `fi`), each
+    /// once. Pieces that only share an edge with it (its neighbours on a mesh) are left out:
+    /// nothing of them is inside it.
+    fn overlapping(&mut self, front: &Piece, fi: u32) -> Vec<u32> {
+        let mut found = Vec::new();
+        for c in self.cells(front.bounds).collect::<smallvec::SmallVec<[usize; 8]>>() {
+            for &q in &self.grid[c] {
+                let fresh = self.stamp[q as usize] != fi;
+                self.stamp[q as usize] = fi;
+                if fresh
+                    && self.arena[q as usize]
+                        .as_ref()
+                        .is_some_and(|p| p.overlaps(front) && !regions_apart(&p.region, &front.region))
+                {
+                    found.push(q);
+                }
+            }
+        }
+        found
+    }
 }
 
 /// An f64 ordered by `total_cmp`, for the heap.
@@ -249,26 +358,34 @@ impl Ord for OrdF64 {
     }
 }
 
-/// The part of `o` (a polygon that casts no shadow) that no visible caster piece in `seen`
+/// The parts of `o` (a polygon that casts no shadow) that no visible caster piece in `seen`
 /// lies in front of.
-fn unshadowed(o: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Result<Region, ClipError> {
-    let mut lit = o.region.clone();
-    for s in seen.iter().filter(|s| s.overlaps(&o) && !regions_apart(&s.region, &o.region)) {
-        stats.clips += 1;
-        let c = clip(&lit, &s.region)?;
-        lit = c.outside;
-        // Over the overlap, the caster hides `o` where it is nearer.
-        let Some(overlap) = Piece::new(o.source, c.inside, o.near) else { continue };
-        let caster = Piece { near: s.near, ..overlap.clone() };
-        let kept = match relation(&caster, &overlap) {
-            Relation::Behind => overlap.region,
-            Relation::Front => continue,
-            Relation::Mixed => match front_part(&caster, &overlap, stats)? {
-                Some(hiding) => clip(&overlap.region, &hiding.region)?.outside,
-                None => overlap.region,
-            },
-        };
-        lit.rings.extend(kept.rings);
+fn unshadowed(o: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
+    let casters: Vec<&Piece> = seen.iter().filter(|s| s.overlaps(&o) && !regions_apart(&s.region, &o.region)).collect();
+    let mut lit = vec![o];
+    for s in casters {
+        let mut next = Vec::with_capacity(lit.len());
+        for piece in lit {
+            if !piece.overlaps(s) {
+                next.push(piece);
+                continue;
+            }
+            let (inside, outside) = cut(&piece, s, stats)?;
+            next.extend(outside);
+            // Over the overlap, the caster hides `o` where it is nearer.
+            for overlap in inside {
+                let caster = Piece { near: s.near, ..overlap.clone() };
+                match relation(&caster, &overlap) {
+                    Relation::Behind => next.push(overlap),
+                    Relation::Front => {}
+                    Relation::Mixed => match front_part(&caster, &overlap, stats)? {
+                        Some(hiding) => next.extend(cut(&overlap, &hiding, stats)?.1),
+                        None => next.push(overlap),
+                    },
+                }
+            }
+        }
+        lit = next;
     }
     Ok(lit)
 }
@@ -419,7 +536,8 @@ fn lit_in_view(
     let done: Vec<(Vec<Piece>, Pass1)> = lists
         .into_par_iter()
         .map(|(casters, others)| {
-            let mut st = Pass1::default();
+            let convex_split = stats.convex_split && !stacked(&casters, &others);
+            let mut st = Pass1 { convex_split, ..Default::default() };
             Ok((lit_pieces(scene, casters, others, &mut st)?, st))
         })
         .collect::<std::result::Result<_, ClipError>>()?;
@@ -436,6 +554,22 @@ fn lit_in_view(
             DetailPolygon { source: p.source, rings }
         })
         .collect())
+}
+
+/// Deepest a list's pieces may lie over one another (by their boxes, on average) for convex
+/// pieces to be split by edges.
+const SPLIT_DEPTH: f64 = 8.0;
+
+/// Whether the pieces lie over one another too deeply to be split by edges: more than
+/// [`SPLIT_DEPTH`] deep on average, by their bounding boxes. Splitting cuts a piece along the
+/// whole lines through the edges over it, so under `d` others a polygon comes apart into
+/// some `d²` convex pieces, where Weiler and Atherton's clipper keeps it one region (a stack
+/// of 200 large quads: 20,625 pieces and a pass ten times as long).
+fn stacked(casters: &[Piece], others: &[Piece]) -> bool {
+    let area = |(lo, hi): (DVec2, DVec2)| (hi - lo).x.max(0.0) * (hi - lo).y.max(0.0);
+    let all = || casters.iter().chain(others).map(|p| p.bounds);
+    let Some(rect) = all().reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else { return false };
+    all().map(area).sum::<f64>() > SPLIT_DEPTH * area(rect)
 }
 
 /// Most casters a region of a light view keeps before it is cut in four.
@@ -546,8 +680,7 @@ fn lit_pieces(
     }
     // Polygons that cast no shadow: lit where no visible caster lies in front.
     for o in others {
-        let lit = unshadowed(o.clone(), &seen, stats)?;
-        pieces.extend(Piece::new(o.source, lit, o.near));
+        pieces.extend(unshadowed(o, &seen, stats)?);
     }
     Ok(pieces)
 }
@@ -556,7 +689,12 @@ impl ShadowDatabase {
     /// Pass 1 and the merge for light `light` of `scene`: every sample's lit detail polygons.
     /// The light's views (every sample's, and a point sample's six cube faces) are
     /// independent, and are sorted in parallel.
-    pub fn build(scene: &Scene, light: usize, counters: &mut Counters) -> Result<ShadowDatabase> {
+    pub fn build(
+        scene: &Scene,
+        light: usize,
+        options: AthertonWeilerGreenbergOptions,
+        counters: &mut Counters,
+    ) -> Result<ShadowDatabase> {
         let l = scene.lights.get(light).ok_or_else(|| {
             Error::InvalidOption(format!(
                 "no light {light}: the scene has {} light(s), numbered from 0",
@@ -574,13 +712,13 @@ impl ShadowDatabase {
         let done: Vec<(usize, Vec<DetailPolygon>, Pass1)> = views
             .into_par_iter()
             .map(|(s, sample, view)| {
-                let mut stats = Pass1::default();
+                let mut stats = Pass1::new(options);
                 let lit = lit_in_view(scene, sample, view, extent, &mut stats).map_err(clip_error)?;
                 Ok((s, lit, stats))
             })
             .collect::<Result<_>>()?;
         let mut samples = vec![Vec::new(); l.sample_count()];
-        let mut stats = Pass1::default();
+        let mut stats = Pass1::new(options);
         for (s, lit, st) in done {
             samples[s].extend(lit);
             stats.add(&st);
@@ -625,7 +763,11 @@ pub struct AthertonWeilerGreenberg<'a> {
 impl<'a> AthertonWeilerGreenberg<'a> {
     /// Builds the databases (or takes the ones in the options) and puts their detail polygons
     /// through the camera.
-    pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Result<Self> {
+    pub fn new(
+        ctx: &'a ShadowContext<'a>,
+        options: AthertonWeilerGreenbergOptions,
+        counters: &mut Counters,
+    ) -> Result<Self> {
         let databases: Arc<Vec<ShadowDatabase>> = match &ctx.awg_database {
             Some(db) if db.len() == ctx.scene.lights.len() => db.clone(),
             Some(_) => {
@@ -633,7 +775,7 @@ impl<'a> AthertonWeilerGreenberg<'a> {
             }
             None => Arc::new(
                 (0..ctx.scene.lights.len())
-                    .map(|l| ShadowDatabase::build(ctx.scene, l, counters))
+                    .map(|l| ShadowDatabase::build(ctx.scene, l, options, counters))
                     .collect::<Result<_>>()?,
             ),
         };

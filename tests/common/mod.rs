@@ -45,7 +45,7 @@ pub fn frame(scene: &Scene, visibility: VisibilityMethod, shadows: ShadowMethod)
 /// The exact scanline-family stages, with the settings that make them exact.
 pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
     use umbra::shadow::Counting;
-    use umbra::shadow::{BouknightKelleyOptions, VolumeOptions};
+    use umbra::shadow::{AthertonWeilerGreenbergOptions, BouknightKelleyOptions, VolumeOptions};
     let volumes = |counting| VolumeOptions { counting, ..VolumeOptions::default() };
     vec![
         ("bouknight-kelley".into(), ShadowMethod::BouknightKelley(BouknightKelleyOptions::default())),
@@ -57,7 +57,11 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
             "bouknight-kelley --no-solid-cull".into(),
             ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: true, solid_cull: false }),
         ),
-        ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg),
+        ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg(Default::default())),
+        (
+            "atherton-weiler-greenberg --no-convex-split".into(),
+            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions { convex_split: false }),
+        ),
         ("crow zpass".into(), ShadowMethod::Crow(volumes(Counting::ZPass))),
         ("crow zfail".into(), ShadowMethod::Crow(volumes(Counting::ZFail))),
         ("stencil-volume zpass".into(), ShadowMethod::StencilVolume(volumes(Counting::ZPass))),

@@ -28,7 +28,7 @@ fn a_traced_line_is_what_trace_gives_at_the_requested_size() {
     for stage in [
         ShadowMethod::BouknightKelley(Default::default()),
         ShadowMethod::Crow(Default::default()),
-        ShadowMethod::AthertonWeilerGreenberg,
+        ShadowMethod::AthertonWeilerGreenberg(Default::default()),
     ] {
         for line in [0, 77, 130, 239] {
             let r = explorer.handle(&format!("/api/trace?line={line}&shadows={}&width=320&height=240", stage.name()));

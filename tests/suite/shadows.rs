@@ -120,7 +120,10 @@ fn solid_cull_is_exercised_on_closed_meshes() {
 #[test]
 fn light_view_regions_are_exercised() {
     let scene = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
-    let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg, ..Default::default() };
+    let opts = umbra::RenderOptions {
+        shadows: ShadowMethod::AthertonWeilerGreenberg(Default::default()),
+        ..Default::default()
+    };
     let awg = umbra::render(&scene, &opts).unwrap();
     let tiles = awg.stats.shadow_counters.get("light_view_tiles");
     assert!(tiles > 4, "{tiles} regions");
@@ -217,8 +220,9 @@ fn one_shadow_database_serves_many_views() {
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/lights.toml");
     let mut scene = load_scaled(&path, 200);
     let mut counters = umbra::Counters::default();
-    let db: Vec<ShadowDatabase> =
-        (0..scene.lights().len()).map(|l| ShadowDatabase::build(&scene, l, &mut counters).unwrap()).collect();
+    let db: Vec<ShadowDatabase> = (0..scene.lights().len())
+        .map(|l| ShadowDatabase::build(&scene, l, Default::default(), &mut counters).unwrap())
+        .collect();
     let db = Arc::new(db);
     for eye in [glam::DVec3::new(0.0, 5.0, 8.5), glam::DVec3::new(-6.0, 3.0, 2.0), glam::DVec3::new(4.0, 6.0, -5.0)] {
         {
@@ -226,9 +230,13 @@ fn one_shadow_database_serves_many_views() {
             c.eye = eye;
             scene.set_camera(c).expect("a valid camera");
         }
-        let fresh = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg);
+        let fresh =
+            frame(&scene, VisibilityMethod::Scanline, ShadowMethod::AthertonWeilerGreenberg(Default::default()));
         let mut renderer = umbra::Renderer::new().with_shadow_database(db.clone());
-        let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg, ..Default::default() };
+        let opts = umbra::RenderOptions {
+            shadows: ShadowMethod::AthertonWeilerGreenberg(Default::default()),
+            ..Default::default()
+        };
         let reused = renderer.render(&scene, &opts).unwrap().frame.clone();
         assert_eq!(fresh.light, reused.light, "view from {eye}");
         assert_light_agree(
@@ -423,12 +431,36 @@ fn a_renderer_keeps_adjacency_only_for_the_same_polygons() {
 #[test]
 fn a_stack_of_covering_polygons_is_not_cut_without_end() {
     let scene = umbra::generate::stacked_quads(200, 160, 90).unwrap();
-    let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg, ..Default::default() };
+    let opts = umbra::RenderOptions {
+        shadows: ShadowMethod::AthertonWeilerGreenberg(Default::default()),
+        ..Default::default()
+    };
     let awg = umbra::render(&scene, &opts).unwrap();
     let tiles = awg.stats.shadow_counters.get("light_view_tiles");
     assert!((1..=16).contains(&tiles), "{tiles} regions");
     let bk = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::BouknightKelley(Default::default()));
     assert_light_agree(&scene, &bk, &awg.frame, "stacked quads against bouknight-kelley");
+}
+
+/// Atherton-Weiler-Greenberg splits convex pieces by edges where the light view's polygons
+/// lie a few deep (the generated spheres: the split's convex pieces make more detail
+/// polygons, with the same light at every pixel as the paper's clipper gives), and keeps
+/// Weiler and Atherton's clipper where they are stacked deep (200 covering quads would come
+/// apart into some 20,000 pieces: there are as many detail polygons as the clipper makes).
+#[test]
+fn convex_pieces_are_split_unless_stacked_deep() {
+    use umbra::shadow::AthertonWeilerGreenbergOptions;
+    let awg = |scene: &umbra::Scene, convex_split| {
+        let shadows = ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions { convex_split });
+        umbra::render(scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
+    };
+    let detail = |r: &umbra::Rendered| r.stats.shadow_counters.get("detail_polygons");
+    let spheres = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
+    let (split, whole) = (awg(&spheres, true), awg(&spheres, false));
+    assert!(detail(&split) > detail(&whole), "{} and {} detail polygons", detail(&split), detail(&whole));
+    assert_light_agree(&spheres, &whole.frame, &split.frame, "split against clipped");
+    let stack = umbra::generate::stacked_quads(200, 160, 90).unwrap();
+    assert_eq!(detail(&awg(&stack, true)), detail(&awg(&stack, false)));
 }
 
 /// Merged shadow volumes leave out the polygons of closed solids turned away from the light

@@ -1,0 +1,264 @@
+//! Splitting one convex polygon by another's edges (ours, beside Weiler-Atherton clipping).
+//!
+//! Weiler & Atherton's clipper ([`super::weiler_atherton`]) takes any two regions and traces
+//! the inside and outside parts of the subject as rings. When both polygons are convex, as a
+//! mesh's triangles and their pieces are, the same two parts come from a much shorter walk:
+//!
+//! 1. **Apart?** Two convex polygons overlap unless the line through an edge of one has the
+//!    other wholly on its far side. If such a line exists, nothing of the subject is inside.
+//! 2. **Cut by each clip edge in turn.** What is left of the subject is split by the line
+//!    through the clip's next edge: the part beyond the line is outside the clip and is kept
+//!    as one piece of the outside part; the part on the clip's side goes on to the next edge.
+//!    This is Sutherland & Hodgman's reentrant clipping ("Reentrant polygon clipping", 1974)
+//!    keeping both sides of every cut, as beam tracing splits polygons by a beam's edges.
+//! 3. **What is left** after the last edge is the inside part.
+//!
+//! Every piece is convex. The outside part is at most one piece per clip edge, pieces that
+//! touch along the cut lines and never overlap: the same region as Weiler-Atherton's outside
+//! ring (with its notch or hole), cut into convex parts. Tolerance, as the clipper's: points
+//! within `1e-9 ×` the inputs' bounding-box diagonal of a cut line lie on it, go to both
+//! sides, and are never moved.
+
+use super::weiler_atherton::{signed_area, Ring};
+use glam::DVec2;
+use smallvec::SmallVec;
+
+/// The two parts of a convex subject split by a convex clip polygon.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Split {
+    /// The part inside the clip polygon, if any.
+    pub inside: Option<Ring>,
+    /// The part outside it, as convex pieces that touch but do not overlap.
+    pub outside: SmallVec<[Ring; 4]>,
+}
+
+/// Whether `ring` is convex: every corner turns the same way (straight corners allowed).
+pub fn is_convex(ring: &[DVec2]) -> bool {
+    let n = ring.len();
+    if n < 3 {
+        return false;
+    }
+    let (mut left, mut right) = (false, false);
+    for i in 0..n {
+        let (a, b, c) = (ring[i], ring[(i + 1) % n], ring[(i + 2) % n]);
+        let turn = (b - a).perp_dot(c - b);
+        left |= turn > 0.0;
+        right |= turn < 0.0;
+    }
+    left != right
+}
+
+/// Splits convex `subject` by convex `clip` (steps 1-3). A subject the clip does not overlap
+/// comes back whole as the outside part.
+pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Split {
+    let whole = || Split { inside: None, outside: SmallVec::from_elem(subject.to_vec(), 1) };
+    let (Some(sb), Some(cb)) = (bounds(subject), bounds(clip)) else { return whole() };
+    let eps = 1e-9 * (sb.1.max(cb.1) - sb.0.min(cb.0)).length().max(1e-300);
+    let (s_turn, c_turn) = (signed_area(subject).signum(), signed_area(clip).signum());
+    if s_turn == 0.0 || c_turn == 0.0 || apart(subject, s_turn, clip, eps) || apart(clip, c_turn, subject, eps) {
+        return whole();
+    }
+    let mut rest = subject.to_vec();
+    let mut outside = SmallVec::new();
+    let n = clip.len();
+    for i in 0..n {
+        let (a, b) = (clip[i], clip[(i + 1) % n]);
+        if a == b {
+            continue; // a repeated corner bounds nothing
+        }
+        let line = Line::through(a, b, c_turn);
+        let (inner, outer) = cut(&rest, |p| line.distance(p), eps);
+        outside.extend(outer);
+        match inner {
+            Some(r) => rest = r,
+            // Touching within the tolerance only: nothing of the subject is inside.
+            None => return whole(),
+        }
+    }
+    Split { inside: Some(rest), outside }
+}
+
+/// Cuts `ring` by the line whose signed distance is `dist` (positive on the kept side): the
+/// parts on the positive and on the negative side, each `None` when nothing of the ring lies
+/// more than `eps` on that side. Either is the ring itself when the other is `None`.
+pub fn cut(ring: &[DVec2], dist: impl Fn(DVec2) -> f64, eps: f64) -> (Option<Ring>, Option<Ring>) {
+    let snap = |d: f64| if d.abs() <= eps { 0.0 } else { d };
+    let d: SmallVec<[f64; 16]> = ring.iter().map(|&p| snap(dist(p))).collect();
+    let (pos, neg) = (d.iter().any(|&x| x > 0.0), d.iter().any(|&x| x < 0.0));
+    if !neg {
+        return (pos.then(|| ring.to_vec()), None);
+    }
+    if !pos {
+        return (None, Some(ring.to_vec()));
+    }
+    let (mut inner, mut outer) = (Vec::with_capacity(ring.len() + 1), Vec::with_capacity(ring.len() + 1));
+    let n = ring.len();
+    for i in 0..n {
+        let (a, da, b, db) = (ring[i], d[i], ring[(i + 1) % n], d[(i + 1) % n]);
+        if da >= 0.0 {
+            inner.push(a);
+        }
+        if da <= 0.0 {
+            outer.push(a);
+        }
+        if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
+            let x = a + (b - a) * (da / (da - db));
+            inner.push(x);
+            outer.push(x);
+        }
+    }
+    (Some(inner), Some(outer))
+}
+
+/// A directed line's signed distance, positive on the side a polygon turning `turn` (+1
+/// counter-clockwise, -1 clockwise) keeps its inside.
+struct Line {
+    a: DVec2,
+    normal: DVec2,
+}
+
+impl Line {
+    fn through(a: DVec2, b: DVec2, turn: f64) -> Line {
+        let dir = b - a;
+        let normal = DVec2::new(-dir.y, dir.x) * (turn / dir.length().max(f64::MIN_POSITIVE));
+        Line { a, normal }
+    }
+
+    fn distance(&self, p: DVec2) -> f64 {
+        (p - self.a).dot(self.normal)
+    }
+}
+
+/// Whether the line through some edge of convex `ring` (turning `turn`) has all of `other`
+/// on its outer side, within `eps`.
+fn apart(ring: &[DVec2], turn: f64, other: &[DVec2], eps: f64) -> bool {
+    let n = ring.len();
+    (0..n).any(|i| {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        a != b && {
+            let line = Line::through(a, b, turn);
+            other.iter().all(|&p| line.distance(p) <= eps)
+        }
+    })
+}
+
+fn bounds(ring: &[DVec2]) -> Option<(DVec2, DVec2)> {
+    let first = *ring.first()?;
+    Some(ring.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::inside_even_odd;
+    use crate::geometry::weiler_atherton::{clip, Region};
+    use proptest::prelude::*;
+
+    fn v(x: f64, y: f64) -> DVec2 {
+        DVec2::new(x, y)
+    }
+
+    fn area(r: &[DVec2]) -> f64 {
+        signed_area(r).abs()
+    }
+
+    #[test]
+    fn a_corner_overlap_leaves_two_outside_pieces() {
+        let square = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(0.0, 2.0)];
+        let other = [v(1.0, 1.0), v(3.0, 1.0), v(3.0, 3.0), v(1.0, 3.0)];
+        let s = split(&square, &other);
+        assert!((area(s.inside.as_ref().unwrap()) - 1.0).abs() < 1e-12);
+        assert_eq!(s.outside.len(), 2);
+        assert!((s.outside.iter().map(|r| area(r)).sum::<f64>() - 3.0).abs() < 1e-12);
+        assert!(s.outside.iter().chain(&s.inside).all(|r| is_convex(r)));
+    }
+
+    #[test]
+    fn neighbours_sharing_an_edge_are_apart() {
+        let a = [v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)];
+        let b = [v(1.0, 0.0), v(1.0, 1.0), v(0.0, 1.0)];
+        let s = split(&a, &b);
+        assert_eq!(s.inside, None);
+        assert_eq!(s.outside.as_slice(), &[a.to_vec()]);
+    }
+
+    #[test]
+    fn inside_and_containing() {
+        let big = [v(0.0, 0.0), v(4.0, 0.0), v(4.0, 4.0), v(0.0, 4.0)];
+        let small = [v(1.0, 1.0), v(2.0, 1.0), v(1.0, 2.0)];
+        let s = split(&small, &big);
+        assert_eq!(s.inside.as_deref(), Some(&small[..]));
+        assert!(s.outside.is_empty());
+        // Clockwise, and holding the clip: the outside is the square less the triangle.
+        let cw: Vec<DVec2> = big.iter().rev().copied().collect();
+        let t = split(&cw, &small);
+        assert!((area(t.inside.as_ref().unwrap()) - 0.5).abs() < 1e-12);
+        assert!((t.outside.iter().map(|r| area(r)).sum::<f64>() - 15.5).abs() < 1e-12);
+    }
+
+    /// A clip polygon with a corner given twice (a mesh's pole triangle, a quad with two
+    /// corners in one place) still clips: the repeated corner's empty edge is no cut line.
+    #[test]
+    fn a_repeated_corner_still_clips() {
+        let square = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(0.0, 2.0)];
+        let tri = [v(1.0, 1.0), v(1.0, 1.0), v(3.0, 1.0), v(1.0, 2.0)];
+        let s = split(&square, &tri);
+        // Inside: the square [1, 2]² below the line x + 2y = 5.
+        assert!((area(s.inside.as_ref().unwrap()) - 0.75).abs() < 1e-12);
+        assert!((s.outside.iter().map(|r| area(r)).sum::<f64>() - 3.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn convexity() {
+        assert!(is_convex(&[v(0.0, 0.0), v(1.0, 0.0), v(2.0, 0.0), v(1.0, 1.0)]));
+        assert!(!is_convex(&[v(0.0, 0.0), v(2.0, 0.0), v(1.0, 0.5), v(2.0, 2.0), v(0.0, 2.0)]));
+        assert!(!is_convex(&[v(0.0, 0.0), v(1.0, 0.0)]));
+    }
+
+    fn convex_polygon() -> impl Strategy<Value = Vec<DVec2>> {
+        // Points on a circle at sorted angles: convex, either way round.
+        (
+            -1.0..1.0f64,
+            -1.0..1.0f64,
+            0.1..1.0f64,
+            prop::collection::vec(0.0..std::f64::consts::TAU, 3..7),
+            any::<bool>(),
+        )
+            .prop_map(|(cx, cy, r, mut angles, ccw)| {
+                angles.sort_by(f64::total_cmp);
+                angles.dedup_by(|a, b| (*a - *b).abs() < 1e-3);
+                let mut ring: Vec<DVec2> = angles.iter().map(|t| v(cx + r * t.cos(), cy + r * t.sin())).collect();
+                if !ccw {
+                    ring.reverse();
+                }
+                ring
+            })
+            .prop_filter("a polygon with area", |r| r.len() >= 3 && area(r) > 1e-3)
+    }
+
+    proptest! {
+        /// The split gives Weiler-Atherton's two parts: at every sample point, inside the
+        /// subject and the clip exactly when inside the inside part, and inside the subject
+        /// but not the clip exactly when inside one outside piece (never two).
+        #[test]
+        fn the_parts_are_weiler_athertons(s in convex_polygon(), c in convex_polygon()) {
+            let parts = split(&s, &c);
+            let wa = clip(&Region::from_ring(s.clone()), &Region::from_ring(c.clone())).unwrap();
+            prop_assert!(parts.outside.iter().chain(&parts.inside).all(|r| is_convex(r)));
+            let inside_area = parts.inside.as_ref().map_or(0.0, |r| area(r));
+            prop_assert!((inside_area - wa.inside.area()).abs() < 1e-9);
+            let outside_area: f64 = parts.outside.iter().map(|r| area(r)).sum();
+            prop_assert!((outside_area - wa.outside.area()).abs() < 1e-9);
+            for i in 0..40 {
+                for j in 0..40 {
+                    let p = v(-2.0 + 4.0 * (i as f64 + 0.5) / 40.0, -2.0 + 4.0 * (j as f64 + 0.5) / 40.0);
+                    let (in_s, in_c) = (inside_even_odd(&s, p), inside_even_odd(&c, p));
+                    let inside = parts.inside.as_ref().is_some_and(|r| inside_even_odd(r, p));
+                    let outside = parts.outside.iter().filter(|r| inside_even_odd(r, p)).count();
+                    prop_assert_eq!(inside, in_s && in_c, "at {:?}", p);
+                    prop_assert_eq!(outside, usize::from(in_s && !in_c), "at {:?}", p);
+                }
+            }
+        }
+    }
+}
