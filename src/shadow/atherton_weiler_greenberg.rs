@@ -28,7 +28,7 @@ use super::projection::{edge_on, faces_away_on_solid};
 use super::{AthertonWeilerGreenbergOptions, ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::convex_split::{self, is_convex};
-use crate::geometry::weiler_atherton::{clip, regions_apart, ClipError, Region, Ring};
+use crate::geometry::weiler_atherton::{clip, regions_apart, signed_area, ClipError, Region, Ring};
 use crate::geometry::{clip_in_place, clip_polygon, even_odd, grid_cells, Plane};
 use crate::scene::{LightSample, ObjText, Scene};
 use crate::stats::Counters;
@@ -324,17 +324,18 @@ impl Sorting {
     fn overlapping(&mut self, front: &Piece, fi: u32) -> Vec<u32> {
         let mut found = Vec::new();
         for c in self.cells(front.bounds).collect::<smallvec::SmallVec<[usize; 8]>>() {
-            for &q in &self.grid[c] {
-                let fresh = self.stamp[q as usize] != fi;
-                self.stamp[q as usize] = fi;
-                if fresh
-                    && self.arena[q as usize]
-                        .as_ref()
-                        .is_some_and(|p| p.overlaps(front) && !regions_apart(&p.region, &front.region))
-                {
-                    found.push(q);
+            // Pieces taken since (hidden, or sorted) leave the cell as it is read.
+            let (arena, stamp) = (&self.arena, &mut self.stamp);
+            self.grid[c].retain(|&q| {
+                let Some(p) = &arena[q as usize] else { return false };
+                if stamp[q as usize] != fi {
+                    stamp[q as usize] = fi;
+                    if p.overlaps(front) && !regions_apart(&p.region, &front.region) {
+                        found.push(q);
+                    }
                 }
-            }
+                true
+            });
         }
         found
     }
@@ -556,27 +557,28 @@ fn lit_in_view(
         .collect())
 }
 
-/// Deepest a list's pieces may lie over one another (by their boxes, on average) for convex
+/// Deepest a list's pieces may lie over one another (by area, on average) for convex
 /// pieces to be split by edges.
 const SPLIT_DEPTH: f64 = 8.0;
 
 /// Whether the pieces lie over one another too deeply to be split by edges: more than
-/// [`SPLIT_DEPTH`] deep on average, by their bounding boxes. Splitting cuts a piece along the
+/// [`SPLIT_DEPTH`] deep on average over their bounding box. Splitting cuts a piece along the
 /// whole lines through the edges over it, so under `d` others a polygon comes apart into
 /// some `d²` convex pieces, where Weiler and Atherton's clipper keeps it one region (a stack
 /// of 200 large quads: 20,625 pieces and a pass ten times as long).
 fn stacked(casters: &[Piece], others: &[Piece]) -> bool {
-    let area = |(lo, hi): (DVec2, DVec2)| (hi - lo).x.max(0.0) * (hi - lo).y.max(0.0);
-    let all = || casters.iter().chain(others).map(|p| p.bounds);
-    let Some(rect) = all().reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else { return false };
-    all().map(area).sum::<f64>() > SPLIT_DEPTH * area(rect)
+    let all = || casters.iter().chain(others);
+    let Some((lo, hi)) = all().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else { return false };
+    let area = |p: &Piece| p.region.rings.iter().map(|r| signed_area(r).abs()).sum::<f64>();
+    all().map(area).sum::<f64>() > SPLIT_DEPTH * (hi - lo).x * (hi - lo).y
 }
 
 /// Most casters a region of a light view keeps before it is cut in four.
 const TILE_PIECES: usize = 128;
 
-/// Regions of a light view (ours, not the paper's), found by cutting the view in four until
-/// each region holds at most [`TILE_PIECES`] casters: each region's pieces, cut to it, are
+/// Regions of a light view (ours, not the paper's), found by cutting the view in four, at the
+/// median of the casters' centres, until each region holds at most [`TILE_PIECES`]
+/// casters: each region's pieces, cut to it, are
 /// sorted on their own, since what hides what inside one region depends only on what lies in
 /// it. A large polygon behind many small ones (a floor under a crowd) is then clipped only by
 /// those over each region, not by all of them in turn, and the regions are sorted in
@@ -593,7 +595,7 @@ fn regions(
     out: &mut Vec<(Vec<Piece>, Vec<Piece>)>,
 ) {
     let (lo, hi) = rect;
-    let mid = (lo + hi) * 0.5;
+    let mid = median_centre(&casters).unwrap_or((lo + hi) * 0.5).clamp(lo, hi);
     let quarters = [
         (lo, mid),
         (DVec2::new(mid.x, lo.y), DVec2::new(hi.x, mid.y)),
@@ -615,6 +617,17 @@ fn regions(
     for ((c, o), q) in cs.into_iter().zip(os).zip(quarters) {
         regions(c, o, q, copies, out);
     }
+}
+
+/// The median of the pieces' box centres, in x and in y: a cut there shares them out evenly
+/// wherever they crowd (a mesh over a floor: cutting the floor's box in the middle would
+/// leave the mesh in one quarter).
+fn median_centre(pieces: &[Piece]) -> Option<DVec2> {
+    let mut xs: Vec<f64> = pieces.iter().map(|p| p.bounds.0.x + p.bounds.1.x).collect();
+    let mut ys: Vec<f64> = pieces.iter().map(|p| p.bounds.0.y + p.bounds.1.y).collect();
+    let k = xs.len().checked_sub(1)? / 2;
+    let (x, y) = (*xs.select_nth_unstable_by(k, f64::total_cmp).1, *ys.select_nth_unstable_by(k, f64::total_cmp).1);
+    Some(DVec2::new(x, y) * 0.5)
 }
 
 /// Each piece into the quarters its box overlaps, cut to each when it crosses a border.

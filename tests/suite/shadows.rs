@@ -442,6 +442,40 @@ fn a_stack_of_covering_polygons_is_not_cut_without_end() {
     assert_light_agree(&scene, &bk, &awg.frame, "stacked quads against bouknight-kelley");
 }
 
+/// Atherton-Weiler-Greenberg cuts its light view where the casters crowd: a mesh of some
+/// thousand lit triangles in one corner of a wide floor is shared out among regions of at
+/// most 128 casters (cut at the middle of the floor instead, the mesh sat in one quarter and
+/// the view was cut into 6 regions in all), and the light agrees with ray-cast's.
+#[test]
+fn light_view_regions_follow_a_crowded_corner() {
+    use glam::DVec3;
+    use umbra::scene::{Camera, Light, Material, Mesh, Object};
+    let ball = umbra::generate::sphere_mesh(DVec3::new(7.0, 1.0, 7.0), 1.0, 2000);
+    let floor = Mesh::from_polygons(&[vec![
+        DVec3::new(-9.0, 0.0, -9.0),
+        DVec3::new(-9.0, 0.0, 9.0),
+        DVec3::new(9.0, 0.0, 9.0),
+        DVec3::new(9.0, 0.0, -9.0),
+    ]]);
+    let camera =
+        Camera { width: 120, height: 90, ..Camera::new(DVec3::new(4.0, 6.0, 12.0), DVec3::new(7.0, 0.5, 7.0)) };
+    let scene = Scene::builder(camera)
+        .material(Material::new("m"))
+        .light(Light::point(DVec3::new(0.0, 12.0, 0.0)))
+        .object(Object::new(floor), "m")
+        .object(Object::new(ball), "m")
+        .build()
+        .unwrap();
+    let opts = umbra::RenderOptions {
+        shadows: ShadowMethod::AthertonWeilerGreenberg(Default::default()),
+        ..Default::default()
+    };
+    let awg = umbra::render(&scene, &opts).unwrap();
+    let tiles = awg.stats.shadow_counters.get("light_view_tiles");
+    assert!(tiles >= 8, "{tiles} regions");
+    assert_light_agree(&scene, &reference(&scene), &awg.frame, "a crowded corner against ray-cast");
+}
+
 /// Atherton-Weiler-Greenberg splits convex pieces by edges where the light view's polygons
 /// lie a few deep (the generated spheres: the split's convex pieces make more detail
 /// polygons, with the same light at every pixel as the paper's clipper gives), and keeps
