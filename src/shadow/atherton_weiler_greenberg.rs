@@ -437,6 +437,10 @@ impl LightView {
                     &|p| p.dot(axis) + p.dot(e2),
                     &|p| p.dot(axis) - near,
                 ];
+                // Most polygons lie wholly outside some side of a face's frustum.
+                if planes.iter().any(|f| a.iter().all(|&p| f(p) < 0.0)) {
+                    return None;
+                }
                 for f in planes {
                     clip_in_place(&mut a, &mut b, f);
                 }
@@ -503,17 +507,14 @@ fn even_odd_region(ring: Vec<DVec2>) -> Region {
 /// the casters sorted, the lit fragments of every polygon taken back into world space.
 fn lit_in_view(
     scene: &Scene,
-    sample: LightSample,
+    unseen: &[bool],
     view: LightView,
     extent: f64,
     stats: &mut Pass1,
 ) -> std::result::Result<Vec<DetailPolygon>, ClipError> {
     let (mut casters, mut others) = (Vec::new(), Vec::new());
     for (i, poly) in scene.polygons.iter().enumerate() {
-        // A light in the polygon's plane gives it no lit area and no shadow; a closed
-        // solid's polygon turned away from the light is unlit, and hides nothing its
-        // solid's polygons turned to the light do not (ours, not the paper's).
-        if edge_on(scene, i, sample, extent) || faces_away_on_solid(scene, i, sample) {
+        if unseen[i] {
             continue;
         }
         let Some((ring, near)) = view.map(scene.verts(i), &poly.plane, 1e-9 * extent) else { continue };
@@ -571,6 +572,17 @@ fn stacked(casters: &[Piece], others: &[Piece]) -> bool {
     let Some((lo, hi)) = all().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else { return false };
     let area = |p: &Piece| p.region.rings.iter().map(|r| signed_area(r).abs()).sum::<f64>();
     all().map(area).sum::<f64>() > SPLIT_DEPTH * (hi - lo).x * (hi - lo).y
+}
+
+/// `unseen[i]`: whether light sample `sample` sees nothing of polygon `i`. A light in the
+/// polygon's plane gives it no lit area and no shadow; a closed solid's polygon turned away
+/// from the light is unlit, and hides nothing its solid's polygons turned to the light do
+/// not (ours, not the paper's).
+fn unseen(scene: &Scene, sample: LightSample, extent: f64) -> Vec<bool> {
+    (0..scene.polygons.len())
+        .into_par_iter()
+        .map(|i| edge_on(scene, i, sample, extent) || faces_away_on_solid(scene, i, sample))
+        .collect()
 }
 
 /// Most casters a region of a light view keeps before it is cut in four.
@@ -700,8 +712,7 @@ fn lit_pieces(
 
 impl ShadowDatabase {
     /// Pass 1 and the merge for light `light` of `scene`: every sample's lit detail polygons.
-    /// The light's views (every sample's, and a point sample's six cube faces) are
-    /// independent, and are sorted in parallel.
+    /// A point sample's six cube faces are independent, and are sorted in parallel.
     pub fn build(
         scene: &Scene,
         light: usize,
@@ -716,20 +727,19 @@ impl ShadowDatabase {
         })?;
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
         let t = Instant::now();
-        let views: Vec<(usize, LightSample, LightView)> = l
-            .samples()
-            .into_iter()
-            .enumerate()
-            .flat_map(|(s, sample)| LightView::views(sample).into_iter().map(move |v| (s, sample, v)))
-            .collect();
-        let done: Vec<(usize, Vec<DetailPolygon>, Pass1)> = views
-            .into_par_iter()
-            .map(|(s, sample, view)| {
-                let mut stats = Pass1::new(options);
-                let lit = lit_in_view(scene, sample, view, extent, &mut stats).map_err(clip_error)?;
-                Ok((s, lit, stats))
-            })
-            .collect::<Result<_>>()?;
+        let mut done: Vec<(usize, Vec<DetailPolygon>, Pass1)> = Vec::new();
+        for (s, sample) in l.samples().into_iter().enumerate() {
+            let unseen = unseen(scene, sample, extent);
+            let views: Vec<(Vec<DetailPolygon>, Pass1)> = LightView::views(sample)
+                .into_par_iter()
+                .map(|view| {
+                    let mut stats = Pass1::new(options);
+                    let lit = lit_in_view(scene, &unseen, view, extent, &mut stats).map_err(clip_error)?;
+                    Ok((lit, stats))
+                })
+                .collect::<Result<_>>()?;
+            done.extend(views.into_iter().map(|(lit, stats)| (s, lit, stats)));
+        }
         let mut samples = vec![Vec::new(); l.sample_count()];
         let mut stats = Pass1::new(options);
         for (s, lit, st) in done {
