@@ -26,8 +26,8 @@ use smallvec::SmallVec;
 /// The two parts of a convex subject split by a convex clip polygon.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Split {
-    /// The part inside the clip polygon, if any.
-    pub inside: Option<Ring>,
+    /// The part inside the clip polygon.
+    pub inside: Ring,
     /// The part outside it, as convex pieces that touch but do not overlap.
     pub outside: SmallVec<[Ring; 4]>,
 }
@@ -48,15 +48,14 @@ pub fn is_convex(ring: &[DVec2]) -> bool {
     left != right
 }
 
-/// Splits convex `subject` by convex `clip` (steps 1-3). A subject the clip does not overlap
-/// comes back whole as the outside part.
-pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Split {
-    let whole = || Split { inside: None, outside: SmallVec::from_elem(subject.to_vec(), 1) };
-    let (Some(sb), Some(cb)) = (bounds(subject), bounds(clip)) else { return whole() };
+/// Splits convex `subject` by convex `clip` (steps 1-3); `None` when the clip does not
+/// overlap it (the subject is all outside).
+pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Option<Split> {
+    let (sb, cb) = (bounds(subject)?, bounds(clip)?);
     let eps = 1e-9 * (sb.1.max(cb.1) - sb.0.min(cb.0)).length().max(1e-300);
     let (s_turn, c_turn) = (signed_area(subject).signum(), signed_area(clip).signum());
     if s_turn == 0.0 || c_turn == 0.0 || apart(subject, s_turn, clip, eps) || apart(clip, c_turn, subject, eps) {
-        return whole();
+        return None;
     }
     let mut rest = subject.to_vec();
     let mut outside = SmallVec::new();
@@ -69,13 +68,10 @@ pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Split {
         let line = Line::through(a, b, c_turn);
         let (inner, outer) = cut(&rest, |p| line.distance(p), eps);
         outside.extend(outer);
-        match inner {
-            Some(r) => rest = r,
-            // Touching within the tolerance only: nothing of the subject is inside.
-            None => return whole(),
-        }
+        // None: touching within the tolerance only, nothing of the subject is inside.
+        rest = inner?;
     }
-    Split { inside: Some(rest), outside }
+    Some(Split { inside: rest, outside })
 }
 
 /// Cuts `ring` by the line whose signed distance is `dist` (positive on the kept side): the
@@ -166,33 +162,31 @@ mod tests {
     fn a_corner_overlap_leaves_two_outside_pieces() {
         let square = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(0.0, 2.0)];
         let other = [v(1.0, 1.0), v(3.0, 1.0), v(3.0, 3.0), v(1.0, 3.0)];
-        let s = split(&square, &other);
-        assert!((area(s.inside.as_ref().unwrap()) - 1.0).abs() < 1e-12);
+        let s = split(&square, &other).unwrap();
+        assert!((area(&s.inside) - 1.0).abs() < 1e-12);
         assert_eq!(s.outside.len(), 2);
         assert!((s.outside.iter().map(|r| area(r)).sum::<f64>() - 3.0).abs() < 1e-12);
-        assert!(s.outside.iter().chain(&s.inside).all(|r| is_convex(r)));
+        assert!(s.outside.iter().chain([&s.inside]).all(|r| is_convex(r)));
     }
 
     #[test]
     fn neighbours_sharing_an_edge_are_apart() {
         let a = [v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)];
         let b = [v(1.0, 0.0), v(1.0, 1.0), v(0.0, 1.0)];
-        let s = split(&a, &b);
-        assert_eq!(s.inside, None);
-        assert_eq!(s.outside.as_slice(), &[a.to_vec()]);
+        assert_eq!(split(&a, &b), None);
     }
 
     #[test]
     fn inside_and_containing() {
         let big = [v(0.0, 0.0), v(4.0, 0.0), v(4.0, 4.0), v(0.0, 4.0)];
         let small = [v(1.0, 1.0), v(2.0, 1.0), v(1.0, 2.0)];
-        let s = split(&small, &big);
-        assert_eq!(s.inside.as_deref(), Some(&small[..]));
+        let s = split(&small, &big).unwrap();
+        assert_eq!(s.inside, small.to_vec());
         assert!(s.outside.is_empty());
         // Clockwise, and holding the clip: the outside is the square less the triangle.
         let cw: Vec<DVec2> = big.iter().rev().copied().collect();
-        let t = split(&cw, &small);
-        assert!((area(t.inside.as_ref().unwrap()) - 0.5).abs() < 1e-12);
+        let t = split(&cw, &small).unwrap();
+        assert!((area(&t.inside) - 0.5).abs() < 1e-12);
         assert!((t.outside.iter().map(|r| area(r)).sum::<f64>() - 15.5).abs() < 1e-12);
     }
 
@@ -202,9 +196,9 @@ mod tests {
     fn a_repeated_corner_still_clips() {
         let square = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(0.0, 2.0)];
         let tri = [v(1.0, 1.0), v(1.0, 1.0), v(3.0, 1.0), v(1.0, 2.0)];
-        let s = split(&square, &tri);
+        let s = split(&square, &tri).unwrap();
         // Inside: the square [1, 2]² below the line x + 2y = 5.
-        assert!((area(s.inside.as_ref().unwrap()) - 0.75).abs() < 1e-12);
+        assert!((area(&s.inside) - 0.75).abs() < 1e-12);
         assert!((s.outside.iter().map(|r| area(r)).sum::<f64>() - 3.25).abs() < 1e-12);
     }
 
@@ -239,13 +233,16 @@ mod tests {
     proptest! {
         /// The split gives Weiler-Atherton's two parts: at every sample point, inside the
         /// subject and the clip exactly when inside the inside part, and inside the subject
-        /// but not the clip exactly when inside one outside piece (never two).
+        /// but not the clip exactly when inside one outside piece (never two); no split
+        /// (`None`) when nothing is inside.
         #[test]
         fn the_parts_are_weiler_athertons(s in convex_polygon(), c in convex_polygon()) {
-            let parts = split(&s, &c);
+            let parts = split(&s, &c)
+                .unwrap_or_else(|| Split { inside: Vec::new(), outside: SmallVec::from_elem(s.clone(), 1) });
             let wa = clip(&Region::from_ring(s.clone()), &Region::from_ring(c.clone())).unwrap();
-            prop_assert!(parts.outside.iter().chain(&parts.inside).all(|r| is_convex(r)));
-            let inside_area = parts.inside.as_ref().map_or(0.0, |r| area(r));
+            prop_assert!(parts.outside.iter().all(|r| is_convex(r)));
+            prop_assert!(parts.inside.is_empty() || is_convex(&parts.inside));
+            let inside_area = area(&parts.inside);
             prop_assert!((inside_area - wa.inside.area()).abs() < 1e-9);
             let outside_area: f64 = parts.outside.iter().map(|r| area(r)).sum();
             prop_assert!((outside_area - wa.outside.area()).abs() < 1e-9);
@@ -253,7 +250,7 @@ mod tests {
                 for j in 0..40 {
                     let p = v(-2.0 + 4.0 * (i as f64 + 0.5) / 40.0, -2.0 + 4.0 * (j as f64 + 0.5) / 40.0);
                     let (in_s, in_c) = (inside_even_odd(&s, p), inside_even_odd(&c, p));
-                    let inside = parts.inside.as_ref().is_some_and(|r| inside_even_odd(r, p));
+                    let inside = inside_even_odd(&parts.inside, p);
                     let outside = parts.outside.iter().filter(|r| inside_even_odd(r, p)).count();
                     prop_assert_eq!(inside, in_s && in_c, "at {:?}", p);
                     prop_assert_eq!(outside, usize::from(in_s && !in_c), "at {:?}", p);

@@ -177,22 +177,32 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
 /// A piece's parts inside and outside another.
 type Parts = (Vec<Piece>, Vec<Piece>);
 
-/// `q` cut by the outline of `by`: its parts inside `by` and outside it. Two convex pieces
-/// are split by `by`'s edges ([`convex_split`], ours: the outside part comes as convex
-/// pieces); any other pair goes through Weiler and Atherton's clipper.
-fn cut(q: &Piece, by: &Piece, stats: &mut Pass1) -> std::result::Result<Parts, ClipError> {
-    stats.clips += 1;
-    if q.convex && by.convex && stats.convex_split {
-        let s = convex_split::split(&q.region.rings[0], &by.region.rings[0]);
+/// `q` cut by the outline of `by`: its parts inside `by` and outside it, or `None` when
+/// nothing of it is inside (`q` stays as it is). Two convex pieces are split by `by`'s edges
+/// ([`convex_split`], ours: the outside part comes as convex pieces); any other pair goes
+/// through Weiler and Atherton's clipper.
+fn cut(q: &Piece, by: &Piece, stats: &mut Pass1) -> std::result::Result<Option<Parts>, ClipError> {
+    if splits(q, by, stats) {
+        let Some(s) = convex_split::split(&q.region.rings[0], &by.region.rings[0]) else { return Ok(None) };
+        stats.clips += 1;
         let piece = |r| Piece::convex(q.source, r, q.near);
-        return Ok((
-            s.inside.into_iter().filter_map(piece).collect(),
+        return Ok(Some((
+            vec![s.inside].into_iter().filter_map(piece).collect(),
             s.outside.into_iter().filter_map(piece).collect(),
-        ));
+        )));
     }
+    stats.clips += 1;
     let c = clip(&q.region, &by.region)?;
+    if c.inside.rings.is_empty() {
+        return Ok(None);
+    }
     let piece = |r| Piece::new(q.source, r, q.near);
-    Ok((piece(c.inside).into_iter().collect(), piece(c.outside).into_iter().collect()))
+    Ok(Some((piece(c.inside).into_iter().collect(), piece(c.outside).into_iter().collect())))
+}
+
+/// Whether [`cut`] splits `q` by `by`'s edges (both convex, and splitting on).
+fn splits(q: &Piece, by: &Piece, stats: &Pass1) -> bool {
+    q.convex && by.convex && stats.convex_split
 }
 
 /// Weiler & Atherton's hidden-surface removal by area sorting: the parts of `list` that
@@ -213,9 +223,12 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
         let Some(front) = sort.arena[fi as usize].take() else { continue };
         // The front polygon's outline splits everything it overlaps into inside and outside.
         let mut inside = Vec::new();
-        for q in sort.overlapping(&front, fi) {
+        for q in sort.overlapping(&front, fi, stats) {
             let Some(piece) = sort.arena[q as usize].take() else { continue };
-            let (ins, outs) = cut(&piece, &front, stats)?;
+            let Some((ins, outs)) = cut(&piece, &front, stats)? else {
+                sort.arena[q as usize] = Some(piece);
+                continue;
+            };
             inside.extend(ins);
             // The outside part takes its parent's place: in the grid (it only shrank) and in
             // the order; further pieces of it join both at the same place in the order.
@@ -254,10 +267,9 @@ fn outside_all(piece: Piece, by: &[Piece], stats: &mut Pass1) -> std::result::Re
     for s in by {
         let mut next = Vec::with_capacity(remains.len());
         for r in remains {
-            if r.overlaps(s) {
-                next.extend(cut(&r, s, stats)?.1);
-            } else {
-                next.push(r);
+            match r.overlaps(s).then(|| cut(&r, s, stats)).transpose()?.flatten() {
+                Some((_, outside)) => next.extend(outside),
+                None => next.push(r),
             }
         }
         remains = next;
@@ -319,9 +331,9 @@ impl Sorting {
     }
 
     /// The pieces still waiting whose insides may meet `front`'s (front polygon `fi`), each
-    /// once. Pieces that only share an edge with it (its neighbours on a mesh) are left out:
-    /// nothing of them is inside it.
-    fn overlapping(&mut self, front: &Piece, fi: u32) -> Vec<u32> {
+    /// once. Pieces that only share an edge with it (its neighbours on a mesh) are left out,
+    /// or, where [`cut`] splits them, found apart by the split: nothing of them is inside it.
+    fn overlapping(&mut self, front: &Piece, fi: u32, stats: &Pass1) -> Vec<u32> {
         let mut found = Vec::new();
         for c in self.cells(front.bounds).collect::<smallvec::SmallVec<[usize; 8]>>() {
             // Pieces taken since (hidden, or sorted) leave the cell as it is read.
@@ -330,7 +342,8 @@ impl Sorting {
                 let Some(p) = &arena[q as usize] else { return false };
                 if stamp[q as usize] != fi {
                     stamp[q as usize] = fi;
-                    if p.overlaps(front) && !regions_apart(&p.region, &front.region) {
+                    // Convex pairs are tested as they are split.
+                    if p.overlaps(front) && (splits(p, front, stats) || !regions_apart(&p.region, &front.region)) {
                         found.push(q);
                     }
                 }
@@ -371,7 +384,10 @@ fn unshadowed(o: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Resul
                 next.push(piece);
                 continue;
             }
-            let (inside, outside) = cut(&piece, s, stats)?;
+            let Some((inside, outside)) = cut(&piece, s, stats)? else {
+                next.push(piece);
+                continue;
+            };
             next.extend(outside);
             // Over the overlap, the caster hides `o` where it is nearer.
             for overlap in inside {
@@ -380,7 +396,10 @@ fn unshadowed(o: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Resul
                     Relation::Behind => next.push(overlap),
                     Relation::Front => {}
                     Relation::Mixed => match front_part(&caster, &overlap, stats)? {
-                        Some(hiding) => next.extend(cut(&overlap, &hiding, stats)?.1),
+                        Some(hiding) => match cut(&overlap, &hiding, stats)? {
+                            Some((_, outside)) => next.extend(outside),
+                            None => next.push(overlap),
+                        },
                         None => next.push(overlap),
                     },
                 }
