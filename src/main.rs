@@ -88,6 +88,11 @@ struct ShadowArgs {
     /// other's edges (to measure what splitting saves).
     #[arg(long)]
     no_convex_split: bool,
+    /// Atherton-Weiler-Greenberg: sort the polygons that lie behind everything they overlap
+    /// in the light view (a floor) with the rest, as the paper does, instead of lighting them
+    /// with the visible pieces over them cut out as holes.
+    #[arg(long)]
+    no_backgrounds: bool,
     /// Crow and stencil-volume: count shadow volumes from the eye with the eye's own count
     /// (zpass), from infinity (zfail), or from zero at the eye (naive-zpass, wrong when the
     /// eye is in shadow).
@@ -193,7 +198,7 @@ impl ShadowArgs {
 
     /// Atherton-Weiler-Greenberg's settings from these flags.
     fn awg(&self) -> AthertonWeilerGreenbergOptions {
-        AthertonWeilerGreenbergOptions { convex_split: !self.no_convex_split }
+        AthertonWeilerGreenbergOptions { convex_split: !self.no_convex_split, backgrounds: !self.no_backgrounds }
     }
 
     /// Every method of `methods` configured by these flags.
@@ -497,6 +502,11 @@ struct ExportArgs {
     /// the paper does, instead of splitting convex pieces by each other's edges.
     #[arg(long)]
     no_convex_split: bool,
+    /// Atherton-Weiler-Greenberg: sort the polygons that lie behind everything they overlap
+    /// in the light view (a floor) with the rest, as the paper does, instead of lighting them
+    /// with the visible pieces over them cut out as holes.
+    #[arg(long)]
+    no_backgrounds: bool,
 }
 
 fn parse<T: std::str::FromStr<Err = Error>>(s: &str) -> Result<T, String> {
@@ -707,7 +717,7 @@ fn export_shadows_command(e: ExportArgs) -> umbra::Result<()> {
     }
     refuse_overwrite(std::slice::from_ref(&e.output), e.force)?;
     let mut counters = umbra::Counters::default();
-    let options = AthertonWeilerGreenbergOptions { convex_split: !e.no_convex_split };
+    let options = AthertonWeilerGreenbergOptions { convex_split: !e.no_convex_split, backgrounds: !e.no_backgrounds };
     let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, options, &mut counters)?;
     db.write_obj(&scene, &e.output)?;
     let polygons: usize = db.samples.iter().map(Vec::len).sum();

@@ -98,6 +98,10 @@ impl Piece {
 struct Pass1 {
     /// Split convex pieces by edges ([`AthertonWeilerGreenbergOptions::convex_split`]).
     convex_split: bool,
+    /// Leave polygons behind everything out of the sort
+    /// ([`AthertonWeilerGreenbergOptions::backgrounds`]).
+    backgrounds: bool,
+    backgrounds_found: u64,
     fragments: u64,
     clips: u64,
     depth_max: u64,
@@ -107,7 +111,7 @@ struct Pass1 {
 
 impl Pass1 {
     fn new(options: AthertonWeilerGreenbergOptions) -> Pass1 {
-        Pass1 { convex_split: options.convex_split, ..Default::default() }
+        Pass1 { convex_split: options.convex_split, backgrounds: options.backgrounds, ..Default::default() }
     }
 
     fn add(&mut self, o: &Pass1) {
@@ -115,6 +119,7 @@ impl Pass1 {
         self.clips += o.clips;
         self.splits += o.splits;
         self.tiles += o.tiles;
+        self.backgrounds_found += o.backgrounds_found;
         self.depth_max = self.depth_max.max(o.depth_max);
     }
 }
@@ -558,7 +563,7 @@ fn lit_in_view(
         .into_par_iter()
         .map(|(casters, others)| {
             let convex_split = stats.convex_split && !stacked(&casters, &others);
-            let mut st = Pass1 { convex_split, ..Default::default() };
+            let mut st = Pass1 { convex_split, backgrounds: stats.backgrounds, ..Default::default() };
             Ok((lit_pieces(scene, casters, others, &mut st)?, st))
         })
         .collect::<std::result::Result<_, ClipError>>()?;
@@ -706,7 +711,6 @@ fn lit_pieces(
     others: Vec<Piece>,
     stats: &mut Pass1,
 ) -> std::result::Result<Vec<Piece>, ClipError> {
-    let seen = visible(casters.clone(), 0, stats)?;
     // The pieces of a face split into a fan never shadow each other: their lit parts come
     // from a sort without their sibling pieces.
     let face = |p: &Piece| scene.polygons[p.source as usize].face;
@@ -715,6 +719,17 @@ fn lit_pieces(
         *pieces_of.entry(face(c)).or_default() += 1;
     }
     let split = |p: &Piece| pieces_of.get(&face(p)).is_some_and(|&n| n > 1);
+    let (mut kept, mut backs) = (Vec::new(), Vec::new());
+    let back = if stats.backgrounds && others.is_empty() { backgrounds(&casters, &split) } else { Vec::new() };
+    for (i, c) in casters.into_iter().enumerate() {
+        if back.get(i) == Some(&true) {
+            backs.push(c);
+        } else {
+            kept.push(c);
+        }
+    }
+    let casters = kept;
+    let seen = visible(casters.clone(), 0, stats)?;
     let mut pieces: Vec<Piece> = seen.iter().filter(|p| !split(p)).cloned().collect();
     for p in casters.iter().filter(|p| split(p)) {
         let list =
@@ -726,7 +741,60 @@ fn lit_pieces(
     for o in others {
         pieces.extend(unshadowed(o, &seen, stats)?);
     }
+    stats.backgrounds_found += backs.len() as u64;
+    for b in backs {
+        pieces.extend(behind_all(b, &seen, stats)?);
+    }
     Ok(pieces)
+}
+
+/// `back[i]`: whether caster `i` lies behind everything in the list it overlaps (ours, not
+/// the paper's): every other caster whose inside meets its inside lies wholly in front of
+/// it. Such a polygon (a floor under a crowd) hides nothing, so the area sort can leave it
+/// out ([`behind_all`] lights it). Pieces of a face split into a fan (`split`) stay in the
+/// sort. Pairs are found by a sweep over the pieces' boxes.
+fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> {
+    let mut back: Vec<bool> = casters.iter().map(|p| !split(p)).collect();
+    let mut order: Vec<usize> = (0..casters.len()).collect();
+    order.sort_unstable_by(|&a, &b| casters[a].bounds.0.x.total_cmp(&casters[b].bounds.0.x));
+    let mut active: Vec<usize> = Vec::new();
+    for &i in &order {
+        let a = &casters[i];
+        active.retain(|&k| casters[k].bounds.1.x >= a.bounds.0.x);
+        for &k in &active {
+            let b = &casters[k];
+            if !(back[i] || back[k]) || !a.overlaps(b) || regions_apart(&a.region, &b.region) {
+                continue;
+            }
+            back[i] &= matches!(relation(b, a), Relation::Front);
+            back[k] &= matches!(relation(a, b), Relation::Front);
+        }
+        active.push(i);
+    }
+    back
+}
+
+/// The lit part of `b`, a polygon behind everything it overlaps: where no visible piece of
+/// `seen` covers it. The visible pieces do not overlap one another, so when all those over
+/// `b` lie inside it they become holes in it, as they are, by the even-odd rule (ours: no
+/// clip); otherwise `b` is cut by each.
+fn behind_all(b: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
+    let over: Vec<&Piece> = seen.iter().filter(|s| s.overlaps(&b) && !regions_apart(&s.region, &b.region)).collect();
+    let within = |s: &&Piece| s.region.rings.iter().flatten().all(|&p| inside_convex(&b.region.rings[0], p));
+    if !(b.convex && over.iter().all(within)) {
+        let over: Vec<Piece> = over.into_iter().cloned().collect();
+        return outside_all(b, &over, stats);
+    }
+    let mut rings = b.region.rings.clone();
+    rings.extend(over.iter().flat_map(|s| s.region.rings.iter().cloned()));
+    Ok(Piece::new(b.source, Region { rings }, b.near).into_iter().collect())
+}
+
+/// Whether `p` lies inside convex `ring` or on its outline.
+fn inside_convex(ring: &[DVec2], p: DVec2) -> bool {
+    let turn = signed_area(ring).signum();
+    let n = ring.len();
+    (0..n).all(|i| (ring[(i + 1) % n] - ring[i]).perp_dot(p - ring[i]) * turn >= 0.0)
 }
 
 impl ShadowDatabase {
@@ -770,6 +838,7 @@ impl ShadowDatabase {
         counters.add("interpenetration_splits", stats.splits);
         counters.add("area_sort_depth_max", stats.depth_max);
         counters.add("light_view_tiles", stats.tiles);
+        counters.add("light_view_backgrounds", stats.backgrounds_found);
         let detail: usize = samples.iter().map(Vec::len).sum();
         let verts: usize = samples.iter().flatten().flat_map(|d| &d.rings).map(Vec::len).sum();
         counters.add("detail_polygons", detail as u64);

@@ -68,11 +68,18 @@ pub struct AthertonWeilerGreenbergOptions {
     /// gives, the outside as convex pieces, from a walk a tenth as long. `false` clips every
     /// pair with Weiler and Atherton's clipper, as the paper does, to measure the saving.
     pub convex_split: bool,
+    /// Leave out of the area sort the polygons that lie behind everything they overlap in
+    /// the light view (a floor under a crowd; default true; ours): they hide nothing, and are
+    /// lit where no visible piece covers them, the visible pieces over them cut out as holes
+    /// without clipping. `false` sorts them with the rest, as the paper does.
+    pub backgrounds: bool,
 }
 
 impl AthertonWeilerGreenbergOptions {
-    /// The paper's two passes, with convex pieces split by edges.
-    pub const DEFAULT: AthertonWeilerGreenbergOptions = AthertonWeilerGreenbergOptions { convex_split: true };
+    /// The paper's two passes, with convex pieces split by edges and backgrounds left out of
+    /// the sort.
+    pub const DEFAULT: AthertonWeilerGreenbergOptions =
+        AthertonWeilerGreenbergOptions { convex_split: true, backgrounds: true };
 }
 
 impl Default for AthertonWeilerGreenbergOptions {

@@ -59,8 +59,11 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
         ),
         ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg(Default::default())),
         (
-            "atherton-weiler-greenberg --no-convex-split".into(),
-            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions { convex_split: false }),
+            "atherton-weiler-greenberg --no-convex-split --no-backgrounds".into(),
+            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions {
+                convex_split: false,
+                backgrounds: false,
+            }),
         ),
         ("crow zpass".into(), ShadowMethod::Crow(volumes(Counting::ZPass))),
         ("crow zfail".into(), ShadowMethod::Crow(volumes(Counting::ZFail))),

@@ -485,7 +485,9 @@ fn light_view_regions_follow_a_crowded_corner() {
 fn convex_pieces_are_split_unless_stacked_deep() {
     use umbra::shadow::AthertonWeilerGreenbergOptions;
     let awg = |scene: &umbra::Scene, convex_split| {
-        let shadows = ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions { convex_split });
+        // Backgrounds sorted with the rest: the floor, under every sphere, is split too.
+        let shadows =
+            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions { convex_split, backgrounds: false });
         umbra::render(scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
     };
     let detail = |r: &umbra::Rendered| r.stats.shadow_counters.get("detail_polygons");
@@ -495,6 +497,28 @@ fn convex_pieces_are_split_unless_stacked_deep() {
     assert_light_agree(&spheres, &whole.frame, &split.frame, "split against clipped");
     let stack = umbra::generate::stacked_quads(200, 160, 90).unwrap();
     assert_eq!(detail(&awg(&stack, true)), detail(&awg(&stack, false)));
+}
+
+/// Atherton-Weiler-Greenberg leaves the floor under the generated spheres out of the area
+/// sort (it lies behind everything over it) and lights it with the visible pieces over it
+/// as holes: far fewer clips than sorting it with the rest, and the same light at every
+/// pixel as ray-cast's.
+#[test]
+fn a_floor_behind_everything_is_left_out_of_the_sort() {
+    use umbra::shadow::AthertonWeilerGreenbergOptions;
+    let scene = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
+    let awg = |backgrounds| {
+        let shadows =
+            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions { convex_split: true, backgrounds });
+        umbra::render(&scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
+    };
+    let (left_out, sorted) = (awg(true), awg(false));
+    let count = |r: &umbra::Rendered, c: &str| r.stats.shadow_counters.get(c);
+    assert!(count(&left_out, "light_view_backgrounds") > 0);
+    assert_eq!(count(&sorted, "light_view_backgrounds"), 0);
+    let clips = (count(&left_out, "clip_operations"), count(&sorted, "clip_operations"));
+    assert!(4 * clips.0 < clips.1, "{clips:?} clips");
+    assert_light_agree(&scene, &reference(&scene), &left_out.frame, "backgrounds left out against ray-cast");
 }
 
 /// Merged shadow volumes leave out the polygons of closed solids turned away from the light
