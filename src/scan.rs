@@ -390,8 +390,16 @@ impl<'a> ActiveEdges<'a> {
     }
 
     /// Steps forward to `line` (which must not be behind the last line walked) and gives its
-    /// crossings; none on lines the table does not reach.
+    /// crossings; none on lines the table does not reach. More than [`LONG_EDGE`] lines
+    /// ahead, the walk starts afresh at `line`, reading the table there (as [`Self::new`]
+    /// does), instead of stepping through every line between: a band of lines far down the
+    /// frame does not walk the lines above it.
     pub fn advance_to(&mut self, line: u32) -> &[Crossing] {
+        if line > self.next.saturating_add(LONG_EDGE) && line < self.end {
+            let entered = self.entered;
+            *self = ActiveEdges::new(self.table, line..self.end);
+            self.entered = entered;
+        }
         while self.next <= line && self.next_line().is_some() {}
         if self.current == Some(line) {
             &self.active
@@ -746,6 +754,39 @@ mod tests {
         let mut b = ActiveEdges::new(&t, 5..10);
         let (y, xs) = b.next_line().unwrap();
         assert_eq!((y, xs.to_vec()), all[5]);
+    }
+
+    /// Advancing far ahead starts the walk afresh there, with the crossings a walk through
+    /// every line would have (compared sorted by x and tag: equal x may come in either
+    /// order), over random rings and jumps of any length.
+    #[test]
+    fn advancing_far_ahead_gives_the_crossings_of_a_full_walk() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut t = EdgeTable::new(400);
+        for tag in 0..300 {
+            let (cx, cy) = (rng.gen_range(0.0..100.0), rng.gen_range(-20.0..420.0));
+            let ring: Vec<DVec2> = (0..rng.gen_range(3..6))
+                .map(|_| DVec2::new(cx + rng.gen_range(-30.0..30.0), cy + rng.gen_range(-90.0..90.0)))
+                .collect();
+            t.add_ring(tag, &ring);
+        }
+        t.finish();
+        let key = |xs: &[Crossing]| {
+            let mut k: Vec<(u64, u32)> = xs.iter().map(|c| (c.x.to_bits(), c.tag)).collect();
+            k.sort_unstable();
+            k
+        };
+        let mut full = ActiveEdges::new(&t, 0..400);
+        let every: Vec<Vec<(u64, u32)>> = (0..400).map(|y| key(full.advance_to(y))).collect();
+        for _ in 0..50 {
+            let mut walk = ActiveEdges::new(&t, 0..400);
+            let mut y = 0;
+            while y < 400 {
+                assert_eq!(key(walk.advance_to(y)), every[y as usize], "line {y}");
+                y += if rng.gen_bool(0.3) { rng.gen_range(33..200) } else { 1 };
+            }
+        }
     }
 
     #[test]
