@@ -536,14 +536,18 @@ fn lit_in_view(
     extent: f64,
     stats: &mut Pass1,
 ) -> std::result::Result<Vec<DetailPolygon>, ClipError> {
+    // The polygons mapped into the view in parallel, kept in order.
+    let mapped: Vec<(Piece, bool)> = (0..scene.polygons.len())
+        .into_par_iter()
+        .filter(|&i| !unseen[i])
+        .filter_map(|i| {
+            let (ring, near) = view.map(scene.verts(i), &scene.polygons[i].plane, 1e-9 * extent)?;
+            Some((Piece::new(i as u32, even_odd_region(ring), near)?, scene.casts_shadows(i)))
+        })
+        .collect();
     let (mut casters, mut others) = (Vec::new(), Vec::new());
-    for (i, poly) in scene.polygons.iter().enumerate() {
-        if unseen[i] {
-            continue;
-        }
-        let Some((ring, near)) = view.map(scene.verts(i), &poly.plane, 1e-9 * extent) else { continue };
-        let Some(piece) = Piece::new(i as u32, even_odd_region(ring), near) else { continue };
-        if scene.casts_shadows(i) {
+    for (piece, casts) in mapped {
+        if casts {
             casters.push(piece);
         } else {
             others.push(piece);
@@ -559,27 +563,27 @@ fn lit_in_view(
     let mut copies = 3 * (casters.len() + others.len());
     regions(casters, others, rect, &mut copies, &mut lists);
     stats.tiles += lists.len() as u64;
-    let done: Vec<(Vec<Piece>, Pass1)> = lists
+    // Step 1(c) too, region by region: the lit pieces back onto their planes.
+    let unmap = |p: Piece| {
+        let plane = scene.polygons[p.source as usize].plane;
+        let rings = p.region.rings.iter().map(|r| r.iter().map(|&q| view.unmap(q, &plane)).collect()).collect();
+        DetailPolygon { source: p.source, rings }
+    };
+    let done: Vec<(Vec<DetailPolygon>, Pass1)> = lists
         .into_par_iter()
         .map(|(casters, others)| {
             let convex_split = stats.convex_split && !stacked(&casters, &others);
             let mut st = Pass1 { convex_split, backgrounds: stats.backgrounds, ..Default::default() };
-            Ok((lit_pieces(scene, casters, others, &mut st)?, st))
+            let lit = lit_pieces(scene, casters, others, &mut st)?;
+            Ok((lit.into_iter().map(unmap).collect(), st))
         })
         .collect::<std::result::Result<_, ClipError>>()?;
-    let mut pieces = Vec::new();
+    let mut detail = Vec::new();
     for (lit, st) in done {
-        pieces.extend(lit);
+        detail.extend(lit);
         stats.add(&st);
     }
-    Ok(pieces
-        .into_iter()
-        .map(|p| {
-            let plane = scene.polygons[p.source as usize].plane;
-            let rings = p.region.rings.iter().map(|r| r.iter().map(|&q| view.unmap(q, &plane)).collect()).collect();
-            DetailPolygon { source: p.source, rings }
-        })
-        .collect())
+    Ok(detail)
 }
 
 /// Deepest a list's pieces may lie over one another (by area, on average) for convex
@@ -891,21 +895,29 @@ impl<'a> AthertonWeilerGreenberg<'a> {
             ),
         };
         let view = ctx.view;
-        let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
         let mut detail = Vec::new();
         for db in databases.iter() {
             for polys in &db.samples {
+                // Through the camera in parallel, into the overlay in order.
+                let screen: Vec<(u32, Vec<Vec<DVec2>>)> = polys
+                    .par_iter()
+                    .filter(|d| ctx.visible[d.source as usize])
+                    .map_init(
+                        || ([Vec::new(), Vec::new()], Vec::new()),
+                        |(scratch, ring), d| {
+                            let mut rings = Vec::new();
+                            for r in &d.rings {
+                                if view.clip_project(r, scratch, ring) {
+                                    rings.push(ring.clone());
+                                }
+                            }
+                            (d.source, rings)
+                        },
+                    )
+                    .collect();
                 let mut overlay = Overlay::new(view.height, ctx.keep_outlines);
-                for d in polys.iter().filter(|d| ctx.visible[d.source as usize]) {
-                    let mut rings = Vec::new();
-                    for r in &d.rings {
-                        if view.clip_project(r, &mut scratch, &mut ring) {
-                            rings.push(ring.clone());
-                        }
-                    }
-                    if !rings.is_empty() {
-                        overlay.add_rings(d.source, &rings);
-                    }
+                for (source, rings) in screen.iter().filter(|s| !s.1.is_empty()) {
+                    overlay.add_rings(*source, rings);
                 }
                 overlay.finish();
                 counters.add("detail_polygons_in_view", overlay.len() as u64);
