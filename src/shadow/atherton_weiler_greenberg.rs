@@ -451,8 +451,6 @@ impl LightView {
     fn map(&self, verts: &[DVec3], plane: &Plane, near: f64) -> Option<(Vec<DVec2>, DepthPlane)> {
         match *self {
             LightView::Face { light, axis, e1, e2 } => {
-                let mut a: Vec<DVec3> = verts.iter().map(|&v| v - light).collect();
-                let mut b = Vec::new();
                 // The frustum |p·e1|, |p·e2| <= p·axis, and a tiny near plane at the light.
                 let planes: [&dyn Fn(DVec3) -> f64; 5] = [
                     &|p| p.dot(axis) - p.dot(e1),
@@ -461,10 +459,13 @@ impl LightView {
                     &|p| p.dot(axis) + p.dot(e2),
                     &|p| p.dot(axis) - near,
                 ];
-                // Most polygons lie wholly outside some side of a face's frustum.
-                if planes.iter().any(|f| a.iter().all(|&p| f(p) < 0.0)) {
+                // Most polygons lie wholly outside some side of a face's frustum: they are
+                // dropped before they are copied.
+                if planes.iter().any(|f| verts.iter().all(|&v| f(v - light) < 0.0)) {
                     return None;
                 }
+                let mut a: Vec<DVec3> = verts.iter().map(|&v| v - light).collect();
+                let mut b = Vec::new();
                 for f in planes {
                     clip_in_place(&mut a, &mut b, f);
                 }
@@ -724,6 +725,9 @@ fn lit_pieces(
     }
     let split = |p: &Piece| pieces_of.get(&face(p)).is_some_and(|&n| n > 1);
     let (mut kept, mut backs) = (Vec::new(), Vec::new());
+    // Backgrounds leave the sort where every polygon here casts shadows: a polygon that
+    // casts none is lit against the visible parts of every caster (`unshadowed`), and a
+    // background's would be missing.
     let back = if stats.backgrounds && others.is_empty() { backgrounds(&casters, &split) } else { Vec::new() };
     for (i, c) in casters.into_iter().enumerate() {
         if back.get(i) == Some(&true) {
