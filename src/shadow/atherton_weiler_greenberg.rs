@@ -35,6 +35,7 @@ use crate::stats::Counters;
 use crate::view::DepthPlane;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
@@ -558,11 +559,10 @@ fn lit_in_view(
     // parallel.
     let all = casters.iter().chain(&others).map(|p| p.bounds);
     let rect = all.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
-    let mut lists = Vec::new();
     // Cutting may copy pieces that straddle a border: at most three more copies in all than
     // there are pieces, however the cuts fall.
-    let mut copies = 3 * (casters.len() + others.len());
-    regions(casters, others, rect, &mut copies, &mut lists);
+    let copies = 3 * (casters.len() + others.len());
+    let lists = regions(casters, others, rect, copies);
     stats.tiles += lists.len() as u64;
     // Step 1(c) too, region by region: the lit pieces back onto their planes.
     let unmap = |p: Piece| {
@@ -626,15 +626,10 @@ const TILE_PIECES: usize = 128;
 /// parallel. A region is not cut where cutting does not pay: where some quarter would hold
 /// every caster of the region, or the quarters together twice as many (casters larger than
 /// the quarters, as a stack of polygons covering one another is: cutting would only copy
-/// them, four times a level), nor once the cuts have made `copies` copies of straddling
-/// pieces.
-fn regions(
-    casters: Vec<Piece>,
-    others: Vec<Piece>,
-    rect: (DVec2, DVec2),
-    copies: &mut usize,
-    out: &mut Vec<(Vec<Piece>, Vec<Piece>)>,
-) {
+/// them, four times a level), nor where the cut would make more than `copies` copies of
+/// straddling pieces (what is left of that budget is shared among the quarters by their
+/// pieces).
+fn regions(casters: Vec<Piece>, others: Vec<Piece>, rect: (DVec2, DVec2), copies: usize) -> Vec<List> {
     let (lo, hi) = rect;
     let mid = median_centre(&casters).unwrap_or((lo + hi) * 0.5).clamp(lo, hi);
     let quarters = [
@@ -648,17 +643,27 @@ fn regions(
     let (held, others_held) =
         (counts.iter().sum::<usize>(), quarters.iter().map(|&q| count(&others, q)).sum::<usize>());
     let made = (held + others_held).saturating_sub(casters.len() + others.len());
-    let pays = counts.iter().all(|&c| c < casters.len()) && held <= 2 * casters.len() && made <= *copies;
+    let pays = counts.iter().all(|&c| c < casters.len()) && held <= 2 * casters.len() && made <= copies;
     if casters.len() <= TILE_PIECES || !pays {
-        out.push((casters, others));
-        return;
+        return vec![(casters, others)];
     }
-    *copies -= made;
+    // The copies left are shared among the quarters by their pieces; the quarters are cut
+    // in parallel, and their regions listed in order.
+    let (left, all) = (copies - made, held + others_held);
     let (cs, os) = (into_quarters(casters, &quarters), into_quarters(others, &quarters));
-    for ((c, o), q) in cs.into_iter().zip(os).zip(quarters) {
-        regions(c, o, q, copies, out);
-    }
+    let quarters: Vec<(List, (DVec2, DVec2))> = cs.into_iter().zip(os).zip(quarters).collect();
+    quarters
+        .into_par_iter()
+        .map(|((c, o), q)| {
+            let share = left * (c.len() + o.len()) / all.max(1);
+            regions(c, o, q, share)
+        })
+        .flatten()
+        .collect()
 }
+
+/// One region's casters and other polygons.
+type List = (Vec<Piece>, Vec<Piece>);
 
 /// The median of the pieces' box centres, in x and in y: a cut there shares them out evenly
 /// wherever they crowd (a mesh over a floor: cutting the floor's box in the middle would
@@ -919,11 +924,18 @@ impl<'a> AthertonWeilerGreenberg<'a> {
                         },
                     )
                     .collect();
-                let mut overlay = Overlay::new(view.height, ctx.keep_outlines);
-                for (source, rings) in screen.iter().filter(|s| !s.1.is_empty()) {
-                    overlay.add_rings(*source, rings);
+                // Grouped by source polygon, in the order sources first come; each source's
+                // edge table is built on its own, in parallel.
+                let mut slot: FxHashMap<u32, usize> = FxHashMap::default();
+                let mut receivers: Vec<(u32, Vec<Vec<Vec<DVec2>>>)> = Vec::new();
+                for (source, rings) in screen.into_iter().filter(|s| !s.1.is_empty()) {
+                    let k = *slot.entry(source).or_insert_with(|| {
+                        receivers.push((source, Vec::new()));
+                        receivers.len() - 1
+                    });
+                    receivers[k].1.push(rings);
                 }
-                overlay.finish();
+                let overlay = Overlay::from_receivers(view.height, ctx.keep_outlines, &receivers, Vec::as_slice);
                 counters.add("detail_polygons_in_view", overlay.len() as u64);
                 detail.push(overlay);
             }

@@ -217,7 +217,7 @@ fn merge(
         }
         receivers.push((b, rings));
     }
-    let overlay = Overlay::from_receivers(ctx.view.height, ctx.keep_outlines, &receivers);
+    let overlay = Overlay::from_receivers(ctx.view.height, ctx.keep_outlines, &receivers, std::slice::from_ref);
     (overlay, total, kept_pairs)
 }
 

@@ -68,10 +68,16 @@ impl Overlay {
         tag
     }
 
-    /// An overlay of single-ring polygons given receiver by receiver (each receiver once),
-    /// tagged in the order given; the receivers' edge tables are built in parallel.
-    pub fn from_receivers(height: u32, keep_rings: bool, receivers: &[(u32, Vec<Vec<DVec2>>)]) -> Self {
-        let receivers: Vec<&(u32, Vec<Vec<DVec2>>)> = receivers.iter().filter(|r| !r.1.is_empty()).collect();
+    /// An overlay of polygons given receiver by receiver (each receiver once), tagged in the
+    /// order given; `rings_of` gives a polygon's rings (holes by the even-odd rule). The
+    /// receivers' edge tables are built in parallel.
+    pub fn from_receivers<P: Sync>(
+        height: u32,
+        keep_rings: bool,
+        receivers: &[(u32, Vec<P>)],
+        rings_of: impl Fn(&P) -> &[Vec<DVec2>] + Sync,
+    ) -> Self {
+        let receivers: Vec<&(u32, Vec<P>)> = receivers.iter().filter(|r| !r.1.is_empty()).collect();
         let mut first = Vec::with_capacity(receivers.len());
         let mut count = 0;
         for r in &receivers {
@@ -83,15 +89,21 @@ impl Overlay {
             .zip(&first)
             .map(|(r, &t0)| {
                 let mut table = EdgeTable::new(height);
-                for (k, ring) in r.1.iter().enumerate() {
-                    table.add_ring(t0 + k as u32, ring);
+                for (k, polygon) in r.1.iter().enumerate() {
+                    for ring in rings_of(polygon) {
+                        table.add_ring(t0 + k as u32, ring);
+                    }
                 }
                 table.finish();
                 table
             })
             .collect();
         let slot = receivers.iter().enumerate().map(|(i, r)| (r.0, i as u32)).collect();
-        let rings = if keep_rings { receivers.iter().flat_map(|r| r.1.iter().cloned()).collect() } else { Vec::new() };
+        let rings = if keep_rings {
+            receivers.iter().flat_map(|r| r.1.iter().flat_map(|p| rings_of(p).iter().cloned())).collect()
+        } else {
+            Vec::new()
+        };
         Overlay { height, tables, slot, count, rings, keep_rings }
     }
 
