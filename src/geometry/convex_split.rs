@@ -53,7 +53,18 @@ pub fn is_convex(ring: &[DVec2]) -> bool {
 pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Option<Split> {
     let (sb, cb) = (bounds(subject)?, bounds(clip)?);
     let eps = 1e-9 * (sb.1.max(cb.1) - sb.0.min(cb.0)).length().max(1e-300);
-    let (s_turn, c_turn) = (signed_area(subject).signum(), signed_area(clip).signum());
+    // +1 counter-clockwise, -1 clockwise, 0 without area (`f64::signum` would give 1).
+    let turn = |r: &[DVec2]| {
+        let a = signed_area(r);
+        if a > 0.0 {
+            1.0
+        } else if a < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    };
+    let (s_turn, c_turn) = (turn(subject), turn(clip));
     if s_turn == 0.0 || c_turn == 0.0 || apart(subject, s_turn, clip, eps) || apart(clip, c_turn, subject, eps) {
         return None;
     }
@@ -200,6 +211,15 @@ mod tests {
         // Inside: the square [1, 2]² below the line x + 2y = 5.
         assert!((area(&s.inside) - 0.75).abs() < 1e-12);
         assert!((s.outside.iter().map(|r| area(r)).sum::<f64>() - 3.25).abs() < 1e-12);
+    }
+
+    /// A polygon without area neither clips nor is clipped.
+    #[test]
+    fn no_area_no_split() {
+        let square = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(0.0, 2.0)];
+        let flat = [v(0.5, 1.0), v(1.0, 1.0), v(1.5, 1.0)];
+        assert_eq!(split(&flat, &square), None);
+        assert_eq!(split(&square, &flat), None);
     }
 
     #[test]
