@@ -36,7 +36,6 @@ use crate::view::DepthPlane;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
-use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
@@ -724,7 +723,7 @@ fn lit_pieces(
     // The pieces of a face split into a fan never shadow each other: their lit parts come
     // from a sort without their sibling pieces.
     let face = |p: &Piece| scene.polygons[p.source as usize].face;
-    let mut pieces_of: HashMap<u32, usize> = HashMap::new();
+    let mut pieces_of: FxHashMap<u32, usize> = FxHashMap::default();
     for c in &casters {
         *pieces_of.entry(face(c)).or_default() += 1;
     }
@@ -792,14 +791,20 @@ fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> 
 /// `b` lie inside it they become holes in it, as they are, by the even-odd rule (ours: no
 /// clip); otherwise `b` is cut by each.
 fn behind_all(b: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
-    let over: Vec<&Piece> = seen.iter().filter(|s| s.overlaps(&b) && !regions_apart(&s.region, &b.region)).collect();
-    let within = |s: &&Piece| s.region.rings.iter().flatten().all(|&p| inside_convex(&b.region.rings[0], p));
-    if !(b.convex && over.iter().all(within)) {
-        let over: Vec<Piece> = over.into_iter().cloned().collect();
-        return outside_all(b, &over, stats);
+    // A piece inside `b` meets it; one that is not is asked whether it is apart.
+    let within = |s: &Piece| b.convex && s.region.rings.iter().flatten().all(|&p| inside_convex(&b.region.rings[0], p));
+    let mut holes = Vec::new();
+    for s in seen.iter().filter(|s| s.overlaps(&b)) {
+        if within(s) {
+            holes.push(s);
+        } else if !regions_apart(&s.region, &b.region) {
+            let over: Vec<Piece> =
+                seen.iter().filter(|s| s.overlaps(&b) && !regions_apart(&s.region, &b.region)).cloned().collect();
+            return outside_all(b, &over, stats);
+        }
     }
     let mut rings = b.region.rings.clone();
-    rings.extend(over.iter().flat_map(|s| s.region.rings.iter().cloned()));
+    rings.extend(holes.iter().flat_map(|s| s.region.rings.iter().cloned()));
     Ok(Piece::new(b.source, Region { rings }, b.near).into_iter().collect())
 }
 
