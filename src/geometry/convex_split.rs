@@ -19,7 +19,7 @@
 //! within `1e-9 ×` the inputs' bounding-box diagonal of a cut line lie on it, go to both
 //! sides, and are never moved.
 
-use super::weiler_atherton::{signed_area, Ring};
+use super::weiler_atherton::{ring_bounds, signed_area, Ring};
 use glam::DVec2;
 use smallvec::SmallVec;
 
@@ -51,19 +51,8 @@ pub fn is_convex(ring: &[DVec2]) -> bool {
 /// Splits convex `subject` by convex `clip` (steps 1-3); `None` when the clip does not
 /// overlap it (the subject is all outside).
 pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Option<Split> {
-    let (sb, cb) = (bounds(subject)?, bounds(clip)?);
+    let (sb, cb) = (ring_bounds(subject)?, ring_bounds(clip)?);
     let eps = 1e-9 * (sb.1.max(cb.1) - sb.0.min(cb.0)).length().max(1e-300);
-    // +1 counter-clockwise, -1 clockwise, 0 without area (`f64::signum` would give 1).
-    let turn = |r: &[DVec2]| {
-        let a = signed_area(r);
-        if a > 0.0 {
-            1.0
-        } else if a < 0.0 {
-            -1.0
-        } else {
-            0.0
-        }
-    };
     let (s_turn, c_turn) = (turn(subject), turn(clip));
     if s_turn == 0.0 || c_turn == 0.0 || apart(subject, s_turn, clip, eps) || apart(clip, c_turn, subject, eps) {
         return None;
@@ -149,9 +138,25 @@ fn apart(ring: &[DVec2], turn: f64, other: &[DVec2], eps: f64) -> bool {
     })
 }
 
-fn bounds(ring: &[DVec2]) -> Option<(DVec2, DVec2)> {
-    let first = *ring.first()?;
-    Some(ring.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+/// Whether every point of `points` lies inside convex `ring` or on its outline (never, for
+/// a ring without area).
+pub fn holds(ring: &[DVec2], mut points: impl Iterator<Item = DVec2>) -> bool {
+    let t = turn(ring);
+    let n = ring.len();
+    t != 0.0 && points.all(|p| (0..n).all(|i| (ring[(i + 1) % n] - ring[i]).perp_dot(p - ring[i]) * t >= 0.0))
+}
+
+/// +1 for a ring wound counter-clockwise, −1 clockwise, 0 without area (where `f64::signum`
+/// would give 1).
+fn turn(ring: &[DVec2]) -> f64 {
+    let a = signed_area(ring);
+    if a > 0.0 {
+        1.0
+    } else if a < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
 }
 
 #[cfg(test)]
@@ -220,6 +225,19 @@ mod tests {
         let flat = [v(0.5, 1.0), v(1.0, 1.0), v(1.5, 1.0)];
         assert_eq!(split(&flat, &square), None);
         assert_eq!(split(&square, &flat), None);
+    }
+
+    /// Points inside a convex ring or on its outline are held, either way round; a point
+    /// outside is not, and a ring without area holds nothing.
+    #[test]
+    fn a_convex_ring_holds_its_inside_and_outline() {
+        let square = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(0.0, 2.0)];
+        let cw: Vec<DVec2> = square.iter().rev().copied().collect();
+        for ring in [&square[..], &cw[..]] {
+            assert!(holds(ring, [v(1.0, 1.0), v(0.0, 1.0), v(2.0, 2.0)].into_iter()));
+            assert!(!holds(ring, [v(1.0, 1.0), v(2.5, 1.0)].into_iter()));
+        }
+        assert!(!holds(&[v(0.0, 0.0), v(1.0, 0.0), v(2.0, 0.0)], [v(1.0, 0.0)].into_iter()));
     }
 
     #[test]

@@ -95,9 +95,14 @@ impl Region {
 
     /// Its bounding box `(min, max)`, or `None` when empty.
     pub fn bounds(&self) -> Option<(DVec2, DVec2)> {
-        let first = *self.rings.iter().flatten().next()?;
-        Some(self.rings.iter().flatten().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+        self.rings.iter().filter_map(|r| ring_bounds(r)).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
     }
+}
+
+/// The bounding box `(min, max)` of a ring's points, or `None` when it has none.
+pub fn ring_bounds(ring: &[DVec2]) -> Option<(DVec2, DVec2)> {
+    let first = *ring.first()?;
+    Some(ring.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
 }
 
 /// The signed area of a ring (positive counter-clockwise).
@@ -287,11 +292,10 @@ fn rings_that_meet(
     (sb, cb): ((DVec2, DVec2), (DVec2, DVec2)),
     eps: f64,
 ) -> (Vec<Ring>, Vec<Ring>, Vec<Ring>) {
-    let ring_box =
-        |r: &Ring| r.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
     let meets = |r: &Ring, b: (DVec2, DVec2)| {
-        let (lo, hi) = ring_box(r);
-        lo.x <= b.1.x + eps && b.0.x <= hi.x + eps && lo.y <= b.1.y + eps && b.0.y <= hi.y + eps
+        ring_bounds(r).is_some_and(|(lo, hi)| {
+            lo.x <= b.1.x + eps && b.0.x <= hi.x + eps && lo.y <= b.1.y + eps && b.0.y <= hi.y + eps
+        })
     };
     let solid = |r: &Ring| signed_area(r).abs() > eps * eps;
     let (near, far): (Vec<Ring>, Vec<Ring>) =

@@ -24,7 +24,7 @@
 //! per sample; the lit fraction is the share of samples that light a point.
 
 use super::overlay::{CoverWalker, Overlay};
-use super::projection::{edge_on, faces_away_on_solid};
+use super::projection::unseen;
 use super::{AthertonWeilerGreenbergOptions, ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::convex_split::{self, is_convex};
@@ -191,10 +191,7 @@ fn cut(q: &Piece, by: &Piece, stats: &mut Pass1) -> std::result::Result<Option<P
         let Some(s) = convex_split::split(&q.region.rings[0], &by.region.rings[0]) else { return Ok(None) };
         stats.clips += 1;
         let piece = |r| Piece::convex(q.source, r, q.near);
-        return Ok(Some((
-            vec![s.inside].into_iter().filter_map(piece).collect(),
-            s.outside.into_iter().filter_map(piece).collect(),
-        )));
+        return Ok(Some((piece(s.inside).into_iter().collect(), s.outside.into_iter().filter_map(piece).collect())));
     }
     stats.clips += 1;
     let c = clip(&q.region, &by.region)?;
@@ -602,17 +599,6 @@ fn stacked(casters: &[Piece], others: &[Piece]) -> bool {
     all().map(area).sum::<f64>() > SPLIT_DEPTH * (hi - lo).x * (hi - lo).y
 }
 
-/// `unseen[i]`: whether light sample `sample` sees nothing of polygon `i`. A light in the
-/// polygon's plane gives it no lit area and no shadow; a closed solid's polygon turned away
-/// from the light is unlit, and hides nothing its solid's polygons turned to the light do
-/// not (ours, not the paper's).
-fn unseen(scene: &Scene, sample: LightSample, extent: f64) -> Vec<bool> {
-    (0..scene.polygons.len())
-        .into_par_iter()
-        .map(|i| edge_on(scene, i, sample, extent) || faces_away_on_solid(scene, i, sample))
-        .collect()
-}
-
 /// Most casters a region of a light view keeps before it is cut in four.
 const TILE_PIECES: usize = 128;
 
@@ -792,7 +778,8 @@ fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> 
 /// clip); otherwise `b` is cut by each.
 fn behind_all(b: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
     // A piece inside `b` meets it; one that is not is asked whether it is apart.
-    let within = |s: &Piece| b.convex && s.region.rings.iter().flatten().all(|&p| inside_convex(&b.region.rings[0], p));
+    let within =
+        |s: &Piece| b.convex && convex_split::holds(&b.region.rings[0], s.region.rings.iter().flatten().copied());
     let mut holes = Vec::new();
     for s in seen.iter().filter(|s| s.overlaps(&b)) {
         if within(s) {
@@ -806,13 +793,6 @@ fn behind_all(b: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Resul
     let mut rings = b.region.rings.clone();
     rings.extend(holes.iter().flat_map(|s| s.region.rings.iter().cloned()));
     Ok(Piece::new(b.source, Region { rings }, b.near).into_iter().collect())
-}
-
-/// Whether `p` lies inside convex `ring` or on its outline.
-fn inside_convex(ring: &[DVec2], p: DVec2) -> bool {
-    let turn = signed_area(ring).signum();
-    let n = ring.len();
-    (0..n).all(|i| (ring[(i + 1) % n] - ring[i]).perp_dot(p - ring[i]) * turn >= 0.0)
 }
 
 impl ShadowDatabase {
@@ -834,7 +814,7 @@ impl ShadowDatabase {
         let t = Instant::now();
         let mut done: Vec<(usize, Vec<DetailPolygon>, Pass1)> = Vec::new();
         for (s, sample) in l.samples().into_iter().enumerate() {
-            let unseen = unseen(scene, sample, extent);
+            let unseen = unseen(scene, sample, extent, true);
             let views: Vec<(Vec<DetailPolygon>, Pass1)> = LightView::views(sample)
                 .into_par_iter()
                 .map(|view| {

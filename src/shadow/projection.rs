@@ -34,6 +34,19 @@ pub fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample) -> bool
     scene.turned_away_on_solid(i, sample)
 }
 
+/// `unseen[i]`: whether light sample `sample` need not consider polygon `i`, found in
+/// parallel: the light lies in its plane ([`edge_on`]: no lit area, no shadow), or, with
+/// `cull`, it is a closed solid's polygon turned away from the light
+/// ([`faces_away_on_solid`]: unlit, and it hides nothing its solid's polygons turned to the
+/// light do not; ours, not the papers').
+pub fn unseen(scene: &Scene, sample: LightSample, extent: f64, cull: bool) -> Vec<bool> {
+    use rayon::prelude::*;
+    (0..scene.polygons.len())
+        .into_par_iter()
+        .map(|i| edge_on(scene, i, sample, extent) || (cull && faces_away_on_solid(scene, i, sample)))
+        .collect()
+}
+
 /// A bounded piece of a plane that polygons are projected onto from one light sample: the
 /// plane, a rectangle of it, and the pyramid from the light over the rectangle (a prism for
 /// a directional light), worked out once for all the polygons projected onto it.

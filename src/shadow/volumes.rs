@@ -47,7 +47,7 @@
 //! ([`SightHull`]), and z-fail's volumes are closed at a plane beyond the scene, with *far
 //! caps* there instead of back caps at infinity, where there is such a plane ([`FarPlane`]).
 
-use super::projection::{edge_on, faces_away_on_solid, light_side, Projector, Target};
+use super::projection::{light_side, unseen, Projector, Target};
 use super::ShadowContext;
 use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane};
 use crate::pool::Stash;
@@ -136,13 +136,9 @@ fn shadow_polygons(
     // With merged volumes, a closed solid's polygons turned away from the light are left out
     // (ours): every shadow ray crossing one has crossed, nearer the light, one of the same
     // solid turned toward it, so the counts change but never between zero and not zero.
-    let culled = |i: usize| adjacency.merged_volumes && faces_away_on_solid(ctx.scene, i, sample);
     // Decided once a polygon: each is asked for on every edge it has.
-    let casting: Vec<bool> = (0..ctx.scene.polygons.len())
-        .into_par_iter()
-        .map(|i| !edge_on(ctx.scene, i, sample, ctx.extent) && !culled(i))
-        .collect();
-    let casts = |i: usize| casting[i];
+    let unseen = unseen(ctx.scene, sample, ctx.extent, adjacency.merged_volumes);
+    let casts = |i: usize| !unseen[i];
     // Step 1: the merged sides, one per edge whose net weight is not zero. Each edge and
     // each polygon is decided on its own, so they are worked out in parallel, in order.
     let mut out: Vec<ShadowPolygon> = adjacency
