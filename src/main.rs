@@ -93,6 +93,11 @@ struct ShadowArgs {
     /// with the visible pieces over them cut out as holes.
     #[arg(long)]
     no_backgrounds: bool,
+    /// Atherton-Weiler-Greenberg: sort the polygons that nothing else in the light view
+    /// meets with the rest, as the paper does, instead of finding them sheet by sheet and
+    /// lighting them whole.
+    #[arg(long)]
+    no_lone_sheets: bool,
     /// Crow and stencil-volume: count shadow volumes from the eye with the eye's own count
     /// (zpass), from infinity (zfail), or from zero at the eye (naive-zpass, wrong when the
     /// eye is in shadow).
@@ -198,7 +203,11 @@ impl ShadowArgs {
 
     /// Atherton-Weiler-Greenberg's settings from these flags.
     fn awg(&self) -> AthertonWeilerGreenbergOptions {
-        AthertonWeilerGreenbergOptions { convex_split: !self.no_convex_split, backgrounds: !self.no_backgrounds }
+        AthertonWeilerGreenbergOptions {
+            convex_split: !self.no_convex_split,
+            backgrounds: !self.no_backgrounds,
+            lone_sheets: !self.no_lone_sheets,
+        }
     }
 
     /// Every method of `methods` configured by these flags.
@@ -507,6 +516,11 @@ struct ExportArgs {
     /// with the visible pieces over them cut out as holes.
     #[arg(long)]
     no_backgrounds: bool,
+    /// Atherton-Weiler-Greenberg: sort the polygons that nothing else in the light view
+    /// meets with the rest, as the paper does, instead of finding them sheet by sheet and
+    /// lighting them whole.
+    #[arg(long)]
+    no_lone_sheets: bool,
 }
 
 fn parse<T: std::str::FromStr<Err = Error>>(s: &str) -> Result<T, String> {
@@ -717,7 +731,11 @@ fn export_shadows_command(e: ExportArgs) -> umbra::Result<()> {
     }
     refuse_overwrite(std::slice::from_ref(&e.output), e.force)?;
     let mut counters = umbra::Counters::default();
-    let options = AthertonWeilerGreenbergOptions { convex_split: !e.no_convex_split, backgrounds: !e.no_backgrounds };
+    let options = AthertonWeilerGreenbergOptions {
+        convex_split: !e.no_convex_split,
+        backgrounds: !e.no_backgrounds,
+        lone_sheets: !e.no_lone_sheets,
+    };
     let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, options, &mut counters)?;
     db.write_obj(&scene, &e.output)?;
     let polygons: usize = db.samples.iter().map(Vec::len).sum();

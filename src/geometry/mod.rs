@@ -5,6 +5,7 @@
 
 pub mod convex_split;
 pub mod even_odd;
+pub(crate) mod lone_sheets;
 pub mod weiler_atherton;
 
 use glam::{DVec2, DVec3};
@@ -211,17 +212,18 @@ pub(crate) fn even_odd_edges(edges: impl IntoIterator<Item = (DVec2, DVec2)>, p:
     inside
 }
 
-/// The cells of a `g` x `g` grid over the box at `lo` of `size` that the box `(a, b)` meets,
-/// as (column, row), clamped to the grid.
+/// The cells of a grid of `gx` columns and `gy` rows over the box at `lo` of `size` that the
+/// box `(a, b)` meets, as (column, row), clamped to the grid.
 pub(crate) fn grid_cells(
     lo: DVec2,
     size: DVec2,
-    g: usize,
+    (gx, gy): (usize, usize),
     (a, b): (DVec2, DVec2),
 ) -> impl Iterator<Item = (usize, usize)> {
-    let cell = move |v: f64, lo: f64, size: f64| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
-    let (c0, c1) = (cell(a.x, lo.x, size.x), cell(b.x, lo.x, size.x));
-    let (r0, r1) = (cell(a.y, lo.y, size.y), cell(b.y, lo.y, size.y));
+    let cell =
+        move |v: f64, lo: f64, size: f64, g: usize| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
+    let (c0, c1) = (cell(a.x, lo.x, size.x, gx), cell(b.x, lo.x, size.x, gx));
+    let (r0, r1) = (cell(a.y, lo.y, size.y, gy), cell(b.y, lo.y, size.y, gy));
     (c0..=c1).flat_map(move |c| (r0..=r1).map(move |r| (c, r)))
 }
 

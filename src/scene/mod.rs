@@ -12,6 +12,9 @@ pub(crate) use solids::Solid;
 pub(crate) use solids::NO_SOLID;
 mod write;
 
+/// No polygon (in [`Scene::across`]).
+pub(crate) const NO_POLYGON: u32 = u32::MAX;
+
 pub use obj::parse_obj;
 
 /// Old Mac line endings: a lone `\r` (no `\n` after it) becomes `\n`. Byte offsets do not
@@ -478,6 +481,10 @@ pub struct Scene {
     pub(crate) solid_of: Vec<u32>,
     /// The closed, consistently wound surfaces among the objects' polygons.
     pub(crate) solids: Vec<Solid>,
+    /// Parallel to `vertices`: the polygon across the edge from each corner to the next,
+    /// where exactly one other polygon of the object runs that edge the other way (between
+    /// the same welded positions), or [`NO_POLYGON`].
+    pub(crate) across: Vec<u32>,
     /// Which compiled polygons these are: a number of its own for every compile (and every
     /// change of the polygons since), shared by clones, so that what a renderer derives from
     /// the polygons (Crow's edge adjacency) can be kept for the next frame of the same scene.
@@ -541,6 +548,7 @@ impl Scene {
             face_count: 0,
             solid_of: Vec::new(),
             solids: Vec::new(),
+            across: Vec::new(),
             polygons_id: next_polygons_id(),
             bounds: None,
         };
@@ -616,9 +624,12 @@ impl Scene {
             }
             self.face_count += mesh.faces.len() as u32;
             let corners = solids::Corners { ranges: &ranges, keys: &keys, verts: &self.vertices[v0 as usize..] };
-            let (of, found) = solids::find(&corners, self.solids.len() as u32);
-            self.solid_of.extend(of);
-            self.solids.extend(found);
+            let found = solids::find(&corners, self.solids.len() as u32);
+            self.solid_of.extend(found.solid_of);
+            self.solids.extend(found.solids);
+            let p0 = self.polygons.len() as u32 - ranges.len() as u32;
+            self.across
+                .extend(found.across.into_iter().map(|q| if q == solids::NO_SOLID { NO_POLYGON } else { p0 + q }));
         }
         self.bounds = self.vertex_bounds();
         Ok(())
@@ -779,6 +790,25 @@ impl Scene {
         outside && from.side_of(&self.polygons[i].plane) * solid.sign < 0.0
     }
 
+    /// Whether polygon `i` is one piece of a non-planar face split into a fan (its face has
+    /// other polygons, which lie next to it in the list).
+    #[inline]
+    pub(crate) fn fan_piece(&self, i: usize) -> bool {
+        let face = self.polygons[i].face;
+        [i.checked_sub(1), Some(i + 1)]
+            .into_iter()
+            .flatten()
+            .any(|q| self.polygons.get(q).is_some_and(|o| o.face == face))
+    }
+
+    /// For each corner of polygon `i`, the polygon across the edge to the next corner, or
+    /// [`NO_POLYGON`] (see [`Scene::across`]).
+    #[inline]
+    pub(crate) fn across(&self, i: usize) -> &[u32] {
+        let p = &self.polygons[i];
+        &self.across[p.start as usize..(p.start + p.len) as usize]
+    }
+
     /// The vertex normals of polygon `i`.
     #[inline]
     pub fn vertex_normals(&self, i: usize) -> &[DVec3] {
@@ -787,12 +817,14 @@ impl Scene {
     }
 
     /// Records that the polygons were changed since compile (a mirror's scene: clipped, left
-    /// out, renumbered): the closed solids found then are forgotten (they are not known for
+    /// out, renumbered): the closed solids and edge neighbours found then are forgotten (they are not known for
     /// the new polygons), and the polygons take a new [`Scene::polygons_id`].
     pub(crate) fn polygons_changed(&mut self) {
         self.solids.clear();
         self.solid_of.clear();
         self.solid_of.resize(self.polygons.len(), solids::NO_SOLID);
+        self.across.clear();
+        self.across.resize(self.vertices.len(), NO_POLYGON);
         self.polygons_id = next_polygons_id();
         self.bounds = self.vertex_bounds();
     }

@@ -43,13 +43,26 @@ pub(crate) struct Corners<'a> {
     pub verts: &'a [DVec3],
 }
 
-/// The solids among one object's polygons: for each polygon its solid's index in the returned
-/// list (offset by `first`), or [`NO_SOLID`].
-pub(crate) fn find(corners: &Corners, first: u32) -> (Vec<u32>, Vec<Solid>) {
+/// What [`find`] finds among one object's polygons.
+pub(crate) struct Found {
+    /// For each polygon, its solid's index in the scene's list, or [`NO_SOLID`].
+    pub solid_of: Vec<u32>,
+    /// The solids, in the order of their first polygons.
+    pub solids: Vec<Solid>,
+    /// For each corner (parallel to `keys`), the polygon (an index among the object's) across
+    /// the edge from that corner to the next, where exactly one other polygon runs that edge
+    /// the other way; [`NO_SOLID`] otherwise.
+    pub across: Vec<u32>,
+}
+
+/// The solids among one object's polygons (their indices in the scene's list offset by
+/// `first`), and which polygon lies across each edge.
+pub(crate) fn find(corners: &Corners, first: u32) -> Found {
     let n = corners.ranges.len();
     let mut sets = DisjointSets::new(n);
     let mut open = vec![false; n];
-    pair_edges(corners, &mut sets, &mut open);
+    let mut across = vec![NO_SOLID; corners.keys.len()];
+    pair_edges(corners, &mut sets, &mut open, &mut across);
     for p in 0..n {
         if open[p] {
             let r = sets.root(p);
@@ -107,13 +120,14 @@ pub(crate) fn find(corners: &Corners, first: u32) -> (Vec<u32>, Vec<Solid>) {
             *s = renumber[*s as usize];
         }
     }
-    (of, solids)
+    Found { solid_of: of, solids, across }
 }
 
-/// Joins the polygons that share an edge and marks `open` those with an edge that is not
-/// shared by exactly one other polygon running the other way.
-fn pair_edges(corners: &Corners, sets: &mut DisjointSets, open: &mut [bool]) {
-    // Each edge as (lesser key, greater key, runs from the greater, polygon).
+/// Joins the polygons that share an edge, marks `open` those with an edge that is not
+/// shared by exactly one other polygon running the other way, and notes in `across` (per
+/// corner) the polygon across each edge that is.
+fn pair_edges(corners: &Corners, sets: &mut DisjointSets, open: &mut [bool], across: &mut [u32]) {
+    // Each edge as (lesser key, greater key, runs from the greater, polygon, its corner).
     let mut edges = Vec::new();
     for (p, &(start, len)) in corners.ranges.iter().enumerate() {
         let keys = &corners.keys[start as usize..(start + len) as usize];
@@ -123,7 +137,7 @@ fn pair_edges(corners: &Corners, sets: &mut DisjointSets, open: &mut [bool]) {
                 open[p] = true;
                 continue;
             }
-            edges.push((a.min(b), a.max(b), a > b, p as u32));
+            edges.push((a.min(b), a.max(b), a > b, p as u32, start + k as u32));
         }
     }
     edges.sort_unstable();
@@ -137,6 +151,8 @@ fn pair_edges(corners: &Corners, sets: &mut DisjointSets, open: &mut [bool]) {
         let group = &edges[i..j];
         if group.len() == 2 && group[0].2 != group[1].2 {
             sets.join(group[0].3 as usize, group[1].3 as usize);
+            across[group[0].4 as usize] = group[1].3;
+            across[group[1].4 as usize] = group[0].3;
         } else {
             for e in group {
                 open[e.3 as usize] = true;

@@ -28,6 +28,7 @@ use super::projection::unseen;
 use super::{AthertonWeilerGreenbergOptions, ShadowContext, ShadowStage, ShadowWalker};
 use crate::error::{Error, Result};
 use crate::geometry::convex_split::{self, is_convex};
+use crate::geometry::lone_sheets::{self, Item, NO_ITEM};
 use crate::geometry::weiler_atherton::{clip, regions_apart, signed_area, ClipError, Region, Ring};
 use crate::geometry::{clip_in_place, clip_polygon, even_odd, grid_cells, Plane};
 use crate::scene::{LightSample, ObjText, Scene};
@@ -66,20 +67,22 @@ struct Piece {
     bounds: (DVec2, DVec2),
     /// Whether the region is one convex ring (then [`cut`] splits it by edges).
     convex: bool,
+    /// Whether the region is the whole source polygon, one ring with its corners in order.
+    whole: bool,
 }
 
 impl Piece {
     fn new(source: u32, region: Region, near: DepthPlane) -> Option<Piece> {
         let bounds = region.bounds()?;
         let convex = region.rings.len() == 1 && is_convex(&region.rings[0]);
-        Some(Piece { source, region, near, bounds, convex })
+        Some(Piece { source, region, near, bounds, convex, whole: false })
     }
 
     /// A piece known to be one convex ring.
     fn convex(source: u32, ring: Ring, near: DepthPlane) -> Option<Piece> {
         let region = Region::from_ring(ring);
         let bounds = region.bounds()?;
-        Some(Piece { source, region, near, bounds, convex: true })
+        Some(Piece { source, region, near, bounds, convex: true, whole: false })
     }
 
     fn overlaps(&self, other: &Piece) -> bool {
@@ -101,7 +104,10 @@ struct Pass1 {
     /// Leave polygons behind everything out of the sort
     /// ([`AthertonWeilerGreenbergOptions::backgrounds`]).
     backgrounds: bool,
+    /// Take lone sheets out of the sort ([`AthertonWeilerGreenbergOptions::lone_sheets`]).
+    lone_sheets: bool,
     backgrounds_found: u64,
+    lone: u64,
     fragments: u64,
     clips: u64,
     depth_max: u64,
@@ -111,7 +117,12 @@ struct Pass1 {
 
 impl Pass1 {
     fn new(options: AthertonWeilerGreenbergOptions) -> Pass1 {
-        Pass1 { convex_split: options.convex_split, backgrounds: options.backgrounds, ..Default::default() }
+        Pass1 {
+            convex_split: options.convex_split,
+            backgrounds: options.backgrounds,
+            lone_sheets: options.lone_sheets,
+            ..Default::default()
+        }
     }
 
     fn add(&mut self, o: &Pass1) {
@@ -120,6 +131,7 @@ impl Pass1 {
         self.splits += o.splits;
         self.tiles += o.tiles;
         self.backgrounds_found += o.backgrounds_found;
+        self.lone += o.lone;
         self.depth_max = self.depth_max.max(o.depth_max);
     }
 }
@@ -317,7 +329,7 @@ impl Sorting {
 
     fn cells(&self, b: (DVec2, DVec2)) -> impl Iterator<Item = usize> {
         let g = self.g;
-        grid_cells(self.lo, self.size, g, b).map(move |(c, r)| c * g + r)
+        grid_cells(self.lo, self.size, (g, g), b).map(move |(c, r)| c * g + r)
     }
 
     /// Adds `p` with sort key `key` (nearest first, then first added).
@@ -444,8 +456,9 @@ impl LightView {
     }
 
     /// Polygon `verts` cut to this view (for a cube face, its frustum) and mapped into it,
-    /// with its nearness function; `None` when nothing is left or it is edge-on.
-    fn map(&self, verts: &[DVec3], plane: &Plane, near: f64) -> Option<(Vec<DVec2>, DepthPlane)> {
+    /// with its nearness function and whether nothing was cut off; `None` when nothing is
+    /// left or it is edge-on.
+    fn map(&self, verts: &[DVec3], plane: &Plane, near: f64) -> Option<(Vec<DVec2>, DepthPlane, bool)> {
         match *self {
             LightView::Face { light, axis, e1, e2 } => {
                 // The frustum |p·e1|, |p·e2| <= p·axis, and a tiny near plane at the light.
@@ -461,6 +474,7 @@ impl LightView {
                 if planes.iter().any(|f| verts.iter().all(|&v| f(v - light) < 0.0)) {
                     return None;
                 }
+                let whole = planes.iter().all(|f| verts.iter().all(|&v| f(v - light) >= 0.0));
                 let mut a: Vec<DVec3> = verts.iter().map(|&v| v - light).collect();
                 let mut b = Vec::new();
                 for f in planes {
@@ -477,7 +491,7 @@ impl LightView {
                 }
                 let n = plane.n;
                 let near_fn = DepthPlane { a: -n.dot(e1) / k, b: -n.dot(e2) / k, c: -n.dot(axis) / k };
-                Some((a.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2)) / p.dot(axis)).collect(), near_fn))
+                Some((a.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2)) / p.dot(axis)).collect(), near_fn, whole))
             }
             LightView::Parallel { d, e1, e2 } => {
                 // The plane's point at (u, v) is u e1 + v e2 + s d with s = −(n·(u e1 + v e2) + d0)/(n·d);
@@ -487,7 +501,7 @@ impl LightView {
                     return None;
                 }
                 let near_fn = DepthPlane { a: plane.n.dot(e1) / nd, b: plane.n.dot(e2) / nd, c: plane.d / nd };
-                Some((verts.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2))).collect(), near_fn))
+                Some((verts.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2))).collect(), near_fn, true))
             }
         }
     }
@@ -509,10 +523,11 @@ impl LightView {
 
 /// A polygon's region for the clipper, whose rings must not cross themselves: a
 /// self-intersecting outline (inside by the even-odd rule) becomes the trapezoids of its
-/// even-odd region ([`crate::geometry::even_odd`]), which touch but never cross.
-fn even_odd_region(ring: Vec<DVec2>) -> Region {
+/// even-odd region ([`crate::geometry::even_odd`]), which touch but never cross. Also
+/// whether it was.
+fn even_odd_region(ring: Vec<DVec2>) -> (Region, bool) {
     if !even_odd::self_intersects(&ring) {
-        return Region::from_ring(ring);
+        return (Region::from_ring(ring), false);
     }
     let rings = even_odd::trapezoids(&ring)
         .into_iter()
@@ -522,7 +537,7 @@ fn even_odd_region(ring: Vec<DVec2>) -> Region {
             (r.len() >= 3).then_some(r)
         })
         .collect();
-    Region { rings }
+    (Region { rings }, true)
 }
 
 /// Steps 1(a)-(c) and 2 for one view of one light sample: the scene mapped into the view,
@@ -539,8 +554,11 @@ fn lit_in_view(
         .into_par_iter()
         .filter(|&i| !unseen[i])
         .filter_map(|i| {
-            let (ring, near) = view.map(scene.verts(i), &scene.polygons[i].plane, 1e-9 * extent)?;
-            Some((Piece::new(i as u32, even_odd_region(ring), near)?, scene.casts_shadows(i)))
+            let (ring, near, whole) = view.map(scene.verts(i), &scene.polygons[i].plane, 1e-9 * extent)?;
+            let (region, crossing) = even_odd_region(ring);
+            let mut piece = Piece::new(i as u32, region, near)?;
+            piece.whole = whole && !crossing;
+            Some((piece, scene.casts_shadows(i)))
         })
         .collect();
     let (mut casters, mut others) = (Vec::new(), Vec::new());
@@ -551,6 +569,14 @@ fn lit_in_view(
             others.push(piece);
         }
     }
+    // Lone pieces and wide backgrounds leave the view before it is cut (ours).
+    let (casters, lone) = if stats.lone_sheets {
+        take_lone(scene, casters, &others, stats.backgrounds)
+    } else {
+        (casters, LoneSplit::default())
+    };
+    stats.lone += lone.lone.len() as u64;
+    stats.backgrounds_found += lone.behind.len() as u64;
     // Independent regions of the view (one, for up to TILE_PIECES casters), sorted in
     // parallel.
     let all = casters.iter().chain(&others).map(|p| p.bounds);
@@ -560,27 +586,150 @@ fn lit_in_view(
     let copies = 3 * (casters.len() + others.len());
     let lists = regions(casters, others, rect, copies);
     stats.tiles += lists.len() as u64;
-    // Step 1(c) too, region by region: the lit pieces back onto their planes.
+    // Step 1(c) too, region by region: the lit pieces back onto their planes (a whole
+    // polygon as it is).
     let unmap = |p: Piece| {
+        if p.whole {
+            return DetailPolygon { source: p.source, rings: vec![scene.verts(p.source as usize).to_vec()] };
+        }
         let plane = scene.polygons[p.source as usize].plane;
         let rings = p.region.rings.iter().map(|r| r.iter().map(|&q| view.unmap(q, &plane)).collect()).collect();
         DetailPolygon { source: p.source, rings }
     };
-    let done: Vec<(Vec<DetailPolygon>, Pass1)> = lists
+    let keep_cover = !lone.behind.is_empty();
+    let done: Vec<(Vec<DetailPolygon>, Vec<Piece>, Pass1)> = lists
         .into_par_iter()
         .map(|(casters, others)| {
             let convex_split = stats.convex_split && !stacked(&casters, &others);
             let mut st = Pass1 { convex_split, backgrounds: stats.backgrounds, ..Default::default() };
-            let lit = lit_pieces(scene, casters, others, &mut st)?;
-            Ok((lit.into_iter().map(unmap).collect(), st))
+            let mut cover = Vec::new();
+            let lit = lit_pieces(scene, casters, others, keep_cover.then_some(&mut cover), &mut st)?;
+            Ok((lit.into_iter().map(unmap).collect(), cover, st))
         })
         .collect::<std::result::Result<_, ClipError>>()?;
     let mut detail = Vec::new();
-    for (lit, st) in done {
+    let mut cover = Vec::new();
+    for (lit, c, st) in done {
         detail.extend(lit);
+        cover.extend(c);
         stats.add(&st);
     }
+    // The wide backgrounds, lit where no visible piece or lone sheet covers them.
+    let over: Vec<&Piece> = cover.iter().chain(&lone.outlines).collect();
+    let behind: Vec<Piece> = lone.behind.into_par_iter().filter_map(|b| holed(b, over.iter().copied())).collect();
+    detail.par_extend(behind.into_par_iter().chain(lone.lone).map(unmap));
     Ok(detail)
+}
+
+/// What the lone-sheet step (ours) takes out of a light view before it is cut into regions.
+#[derive(Debug, Default)]
+struct LoneSplit {
+    /// Pieces that nothing else in the view meets ([`lone_sheets`]): wholly lit, and they
+    /// hide nothing but wide backgrounds.
+    lone: Vec<Piece>,
+    /// The outlines of the lone pieces, sheet by sheet: the holes they make in `behind`.
+    outlines: Vec<Piece>,
+    /// Wide backgrounds ([`wide_backgrounds`]), lit last.
+    behind: Vec<Piece>,
+}
+
+/// Step 1(b), ours, before the sort: the casters no other polygon in the view meets leave
+/// it, found sheet by sheet ([`lone_sheets`]: the side of a closed mesh that faces the light
+/// is one sheet, whose polygons never overlap one another), and so do wide backgrounds,
+/// which would otherwise meet everything over them. Returns the casters left.
+fn take_lone(scene: &Scene, casters: Vec<Piece>, others: &[Piece], backgrounds: bool) -> (Vec<Piece>, LoneSplit) {
+    let behind =
+        if backgrounds && others.is_empty() { wide_backgrounds(scene, &casters) } else { vec![false; casters.len()] };
+    let kept: Vec<usize> = (0..casters.len()).filter(|&i| !behind[i]).collect();
+    // The items across each whole piece's edges, by their places among the kept.
+    let local: FxHashMap<u32, u32> = kept
+        .iter()
+        .enumerate()
+        .filter(|(_, &i)| casters[i].whole)
+        .map(|(k, &i)| (casters[i].source, k as u32))
+        .collect();
+    let mut across = Vec::new();
+    let mut first = Vec::with_capacity(kept.len());
+    for &i in &kept {
+        first.push(across.len());
+        if casters[i].whole {
+            let near = scene.across(casters[i].source as usize);
+            across.extend(near.iter().map(|q| local.get(q).copied().unwrap_or(NO_ITEM)));
+        }
+    }
+    let items: Vec<Item> = kept
+        .iter()
+        .zip(&first)
+        .map(|(&i, &f)| {
+            let p = &casters[i];
+            let sheet = p.whole.then(|| (p.region.rings[0].as_slice(), &across[f..f + p.region.rings[0].len()]));
+            Item { bounds: p.bounds, sheet }
+        })
+        .chain(others.iter().map(|p| Item { bounds: p.bounds, sheet: None }))
+        .collect();
+    let found = lone_sheets::find(&items);
+    let outlines = found
+        .outlines
+        .into_iter()
+        .filter_map(|(one, rings)| {
+            let p = &casters[kept[one as usize]];
+            Piece::new(p.source, Region { rings }, p.near)
+        })
+        .collect();
+    let mut is_lone = vec![false; casters.len()];
+    for (k, &i) in kept.iter().enumerate() {
+        is_lone[i] = found.lone[k];
+    }
+    let mut split = LoneSplit { outlines, ..Default::default() };
+    let mut rest = Vec::with_capacity(casters.len());
+    for (i, p) in casters.into_iter().enumerate() {
+        match (behind[i], is_lone[i]) {
+            (true, _) => split.behind.push(p),
+            (_, true) => split.lone.push(p),
+            _ => rest.push(p),
+        }
+    }
+    (rest, split)
+}
+
+/// Most wide polygons a light view tries as backgrounds.
+const WIDE_TRIED: usize = 16;
+
+/// `behind[i]`: whether caster `i` is a wide background (ours): convex, not a piece of a
+/// fan, with a box at least 1/64 of the view's, and every other caster whose box meets its
+/// box lies inside it and wholly in front of it. It hides nothing and is met by everything
+/// over it; left out of the regions, it is lit at the end, the visible pieces over it cut
+/// out as holes.
+fn wide_backgrounds(scene: &Scene, casters: &[Piece]) -> Vec<bool> {
+    let mut behind = vec![false; casters.len()];
+    let Some((lo, hi)) = casters.iter().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else {
+        return behind;
+    };
+    let area = |b: (DVec2, DVec2)| (b.1 - b.0).x * (b.1 - b.0).y;
+    let mut wide: Vec<usize> = (0..casters.len())
+        .filter(|&i| casters[i].convex && area(casters[i].bounds) * 64.0 >= area((lo, hi)))
+        .filter(|&i| !scene.fan_piece(casters[i].source as usize))
+        .collect();
+    wide.sort_unstable_by(|&a, &b| area(casters[b].bounds).total_cmp(&area(casters[a].bounds)));
+    for &w in wide.iter().take(WIDE_TRIED) {
+        let b = &casters[w];
+        let ring = &b.region.rings[0];
+        behind[w] = casters.par_iter().enumerate().all(|(i, q)| {
+            let points = || q.region.rings.iter().flatten().copied();
+            i == w
+                || !q.overlaps(b)
+                || (convex_split::holds(ring, points()) && matches!(relation(q, b), Relation::Front))
+        });
+    }
+    behind
+}
+
+/// `b` with the pieces of `over` that meet its box cut out as holes (by the even-odd rule):
+/// they must lie inside it and not overlap one another.
+fn holed<'a>(b: Piece, over: impl Iterator<Item = &'a Piece>) -> Option<Piece> {
+    let mut rings = b.region.rings.clone();
+    rings.extend(over.filter(|s| s.overlaps(&b)).flat_map(|s| s.region.rings.iter().cloned()));
+    Piece::new(b.source, Region { rings }, b.near)
 }
 
 /// Deepest a list's pieces may lie over one another (by area, on average) for convex
@@ -700,10 +849,13 @@ fn cut_to(region: &Region, (lo, hi): (DVec2, DVec2)) -> Region {
 }
 
 /// Step 1(b) on one list of pieces: the lit part of every caster and of every other polygon.
+/// With `cover`, also the pieces that cover the casters' area once over: the visible pieces
+/// and the lit parts of backgrounds.
 fn lit_pieces(
     scene: &Scene,
     casters: Vec<Piece>,
     others: Vec<Piece>,
+    mut cover: Option<&mut Vec<Piece>>,
     stats: &mut Pass1,
 ) -> std::result::Result<Vec<Piece>, ClipError> {
     // The pieces of a face split into a fan never shadow each other: their lit parts come
@@ -741,7 +893,14 @@ fn lit_pieces(
     }
     stats.backgrounds_found += backs.len() as u64;
     for b in backs {
-        pieces.extend(behind_all(b, &seen, stats)?);
+        let lit = behind_all(b, &seen, stats)?;
+        if let Some(c) = cover.as_deref_mut() {
+            c.extend(lit.iter().cloned());
+        }
+        pieces.extend(lit);
+    }
+    if let Some(c) = cover {
+        c.extend(seen);
     }
     Ok(pieces)
 }
@@ -790,9 +949,7 @@ fn behind_all(b: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Resul
             return outside_all(b, &over, stats);
         }
     }
-    let mut rings = b.region.rings.clone();
-    rings.extend(holes.iter().flat_map(|s| s.region.rings.iter().cloned()));
-    Ok(Piece::new(b.source, Region { rings }, b.near).into_iter().collect())
+    Ok(holed(b, holes.into_iter()).into_iter().collect())
 }
 
 impl ShadowDatabase {
@@ -837,6 +994,7 @@ impl ShadowDatabase {
         counters.add("area_sort_depth_max", stats.depth_max);
         counters.add("light_view_tiles", stats.tiles);
         counters.add("light_view_backgrounds", stats.backgrounds_found);
+        counters.add("light_view_lone", stats.lone);
         let detail: usize = samples.iter().map(Vec::len).sum();
         let verts: usize = samples.iter().flatten().flat_map(|d| &d.rings).map(Vec::len).sum();
         counters.add("detail_polygons", detail as u64);
@@ -893,9 +1051,16 @@ impl<'a> AthertonWeilerGreenberg<'a> {
         for db in databases.iter() {
             for polys in &db.samples {
                 // Through the camera in parallel, into the overlay in order.
+                // A detail polygon that is its whole source polygon (ours) covers every run
+                // on it: it needs no edges (but is drawn with them for `--debug`).
+                let whole = |d: &DetailPolygon| {
+                    !ctx.keep_outlines && matches!(&d.rings[..], [r] if r[..] == *ctx.scene.verts(d.source as usize))
+                };
+                let wholes: Vec<u32> =
+                    polys.par_iter().filter(|d| ctx.visible[d.source as usize] && whole(d)).map(|d| d.source).collect();
                 let screen: Vec<(u32, Vec<Vec<DVec2>>)> = polys
                     .par_iter()
-                    .filter(|d| ctx.visible[d.source as usize])
+                    .filter(|d| ctx.visible[d.source as usize] && !whole(d))
                     .map_init(
                         || ([Vec::new(), Vec::new()], Vec::new()),
                         |(scratch, ring), d| {
@@ -920,7 +1085,8 @@ impl<'a> AthertonWeilerGreenberg<'a> {
                     });
                     receivers[k].1.push(rings);
                 }
-                let overlay = Overlay::from_receivers(view.height, ctx.keep_outlines, &receivers, Vec::as_slice);
+                let mut overlay = Overlay::from_receivers(view.height, ctx.keep_outlines, &receivers, Vec::as_slice);
+                overlay.add_wholes(&wholes);
                 counters.add("detail_polygons_in_view", overlay.len() as u64);
                 detail.push(overlay);
             }

@@ -381,7 +381,7 @@ impl SphereGrid {
         let (lo, size) = (DVec2::new(d[0], d[1]), DVec2::new(d[2] - d[0], d[3] - d[1]).max(DVec2::splat(1e-300)));
         let g = self.g;
         let boxes = self.extents[i as usize].boxes.into_iter().flatten();
-        boxes.flat_map(move |b| grid_cells(lo, size, g, (DVec2::new(b[0], b[1]), DVec2::new(b[2], b[3]))))
+        boxes.flat_map(move |b| grid_cells(lo, size, (g, g), (DVec2::new(b[0], b[1]), DVec2::new(b[2], b[3]))))
     }
 
     /// The casters whose extents overlap receiver `b`'s: those sharing a grid cell with it

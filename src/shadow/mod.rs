@@ -73,13 +73,19 @@ pub struct AthertonWeilerGreenbergOptions {
     /// lit where no visible piece covers them, the visible pieces over them cut out as holes
     /// without clipping. `false` sorts them with the rest, as the paper does.
     pub backgrounds: bool,
+    /// Take out of the area sort, before the light view is cut into regions, the polygons
+    /// that no other polygon in the view meets (default true; ours): they are found sheet by
+    /// sheet (the side of a closed mesh facing the light, whose polygons never overlap one
+    /// another) on a grid, without testing pairs, and are wholly lit. `false` sorts them with
+    /// the rest, as the paper does.
+    pub lone_sheets: bool,
 }
 
 impl AthertonWeilerGreenbergOptions {
-    /// The paper's two passes, with convex pieces split by edges and backgrounds left out of
-    /// the sort.
+    /// The paper's two passes, with convex pieces split by edges, and backgrounds and lone
+    /// sheets left out of the sort.
     pub const DEFAULT: AthertonWeilerGreenbergOptions =
-        AthertonWeilerGreenbergOptions { convex_split: true, backgrounds: true };
+        AthertonWeilerGreenbergOptions { convex_split: true, backgrounds: true, lone_sheets: true };
 }
 
 impl Default for AthertonWeilerGreenbergOptions {

@@ -21,10 +21,19 @@ pub struct Overlay {
     height: u32,
     /// One edge table per receiver, in the order receivers first appeared.
     tables: Vec<EdgeTable>,
-    slot: FxHashMap<u32, u32>,
+    slot: FxHashMap<u32, Slot>,
     count: usize,
     rings: Vec<Vec<DVec2>>,
     keep_rings: bool,
+}
+
+/// What an overlay holds for one receiver.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Slot {
+    /// Its polygons' edge table (an index into `tables`).
+    Table(u32),
+    /// One polygon, tagged so, that covers the whole receiver.
+    Whole(u32),
 }
 
 /// Where overlay polygon `tag` covers pixels `start..end` of the current line.
@@ -53,8 +62,9 @@ impl Overlay {
     /// Adds a polygon with several rings (holes, by the even-odd rule) lying on `receiver`.
     pub fn add_rings(&mut self, receiver: u32, rings: &[Vec<DVec2>]) -> u32 {
         let tag = self.count as u32;
-        let next = self.tables.len() as u32;
-        let slot = *self.slot.entry(receiver).or_insert(next) as usize;
+        let next = Slot::Table(self.tables.len() as u32);
+        let Slot::Table(slot) = *self.slot.entry(receiver).or_insert(next) else { return tag };
+        let slot = slot as usize;
         if slot == self.tables.len() {
             self.tables.push(EdgeTable::new(self.height));
         }
@@ -98,13 +108,23 @@ impl Overlay {
                 table
             })
             .collect();
-        let slot = receivers.iter().enumerate().map(|(i, r)| (r.0, i as u32)).collect();
+        let slot = receivers.iter().enumerate().map(|(i, r)| (r.0, Slot::Table(i as u32))).collect();
         let rings = if keep_rings {
             receivers.iter().flat_map(|r| r.1.iter().flat_map(|p| rings_of(p).iter().cloned())).collect()
         } else {
             Vec::new()
         };
         Overlay { height, tables, slot, count, rings, keep_rings }
+    }
+
+    /// Adds, for each of `receivers`, one polygon that covers it whole (its outline is the
+    /// receiver's own), tagged in the order given: a run on it is covered from end to end,
+    /// with no edges to walk. It takes the place of any polygons added on it before.
+    pub fn add_wholes(&mut self, receivers: &[u32]) {
+        for &r in receivers {
+            self.slot.insert(r, Slot::Whole(self.count as u32));
+            self.count += 1;
+        }
     }
 
     /// Sorts the edge tables; call once after the last `add`.
@@ -169,7 +189,11 @@ impl OverlayWalker<'_> {
     /// `receiver` cover pixels of `x0..x1` (clipped to it), ordered by where they start.
     pub fn intervals(&mut self, receiver: u32, x0: u32, x1: u32, out: &mut Vec<Interval>) {
         out.clear();
-        let Some(&slot) = self.overlay.slot.get(&receiver) else { return };
+        let slot = match self.overlay.slot.get(&receiver) {
+            None => return,
+            Some(&Slot::Whole(tag)) => return out.push(Interval { start: x0, end: x1, tag }),
+            Some(&Slot::Table(slot)) => slot,
+        };
         let table = &self.overlay.tables[slot as usize];
         let (line, end) = (self.line, self.end);
         let cached = &mut self.lines[slot as usize];

@@ -434,10 +434,7 @@ impl Adjacency {
                 continue;
             }
             let verts = scene.verts(p);
-            let fan_piece = [p.checked_sub(1), Some(p + 1)]
-                .into_iter()
-                .flatten()
-                .any(|q| scene.polygons.get(q).is_some_and(|o| o.face == poly.face));
+            let fan_piece = scene.fan_piece(p);
             // Only a polygon of four or more corners can cross itself (most meshes are
             // triangles: no ring is built for them).
             let axis = dominant_axis(poly.plane.n);

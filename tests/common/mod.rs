@@ -59,10 +59,11 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
         ),
         ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg(Default::default())),
         (
-            "atherton-weiler-greenberg --no-convex-split --no-backgrounds".into(),
+            "atherton-weiler-greenberg --no-convex-split --no-backgrounds --no-lone-sheets".into(),
             ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions {
                 convex_split: false,
                 backgrounds: false,
+                lone_sheets: false,
             }),
         ),
         ("crow zpass".into(), ShadowMethod::Crow(volumes(Counting::ZPass))),

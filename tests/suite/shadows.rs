@@ -120,10 +120,10 @@ fn solid_cull_is_exercised_on_closed_meshes() {
 #[test]
 fn light_view_regions_are_exercised() {
     let scene = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
-    let opts = umbra::RenderOptions {
-        shadows: ShadowMethod::AthertonWeilerGreenberg(Default::default()),
-        ..Default::default()
-    };
+    // Lone sheets sorted with the rest: the ball's lit side would otherwise leave the view
+    // before it is cut.
+    let options = umbra::shadow::AthertonWeilerGreenbergOptions { lone_sheets: false, ..Default::default() };
+    let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg(options), ..Default::default() };
     let awg = umbra::render(&scene, &opts).unwrap();
     let tiles = awg.stats.shadow_counters.get("light_view_tiles");
     assert!(tiles > 4, "{tiles} regions");
@@ -431,10 +431,10 @@ fn a_renderer_keeps_adjacency_only_for_the_same_polygons() {
 #[test]
 fn a_stack_of_covering_polygons_is_not_cut_without_end() {
     let scene = umbra::generate::stacked_quads(200, 160, 90).unwrap();
-    let opts = umbra::RenderOptions {
-        shadows: ShadowMethod::AthertonWeilerGreenberg(Default::default()),
-        ..Default::default()
-    };
+    // Lone sheets sorted with the rest: the ball's lit side would otherwise leave the view
+    // before it is cut.
+    let options = umbra::shadow::AthertonWeilerGreenbergOptions { lone_sheets: false, ..Default::default() };
+    let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg(options), ..Default::default() };
     let awg = umbra::render(&scene, &opts).unwrap();
     let tiles = awg.stats.shadow_counters.get("light_view_tiles");
     assert!((1..=16).contains(&tiles), "{tiles} regions");
@@ -466,10 +466,10 @@ fn light_view_regions_follow_a_crowded_corner() {
         .object(Object::new(ball), "m")
         .build()
         .unwrap();
-    let opts = umbra::RenderOptions {
-        shadows: ShadowMethod::AthertonWeilerGreenberg(Default::default()),
-        ..Default::default()
-    };
+    // Lone sheets sorted with the rest: the ball's lit side would otherwise leave the view
+    // before it is cut.
+    let options = umbra::shadow::AthertonWeilerGreenbergOptions { lone_sheets: false, ..Default::default() };
+    let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg(options), ..Default::default() };
     let awg = umbra::render(&scene, &opts).unwrap();
     let tiles = awg.stats.shadow_counters.get("light_view_tiles");
     assert!(tiles >= 8, "{tiles} regions");
@@ -485,9 +485,13 @@ fn light_view_regions_follow_a_crowded_corner() {
 fn convex_pieces_are_split_unless_stacked_deep() {
     use umbra::shadow::AthertonWeilerGreenbergOptions;
     let awg = |scene: &umbra::Scene, convex_split| {
-        // Backgrounds sorted with the rest: the floor, under every sphere, is split too.
-        let shadows =
-            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions { convex_split, backgrounds: false });
+        // Backgrounds and lone sheets sorted with the rest: the floor, under every sphere, is
+        // split too.
+        let shadows = ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions {
+            convex_split,
+            backgrounds: false,
+            lone_sheets: false,
+        });
         umbra::render(scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
     };
     let detail = |r: &umbra::Rendered| r.stats.shadow_counters.get("detail_polygons");
@@ -507,9 +511,13 @@ fn convex_pieces_are_split_unless_stacked_deep() {
 fn a_floor_behind_everything_is_left_out_of_the_sort() {
     use umbra::shadow::AthertonWeilerGreenbergOptions;
     let scene = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
+    // Lone sheets sorted with the rest: the backgrounds are found region by region.
     let awg = |backgrounds| {
-        let shadows =
-            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions { convex_split: true, backgrounds });
+        let shadows = ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions {
+            convex_split: true,
+            backgrounds,
+            lone_sheets: false,
+        });
         umbra::render(&scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
     };
     let (left_out, sorted) = (awg(true), awg(false));
@@ -519,6 +527,35 @@ fn a_floor_behind_everything_is_left_out_of_the_sort() {
     let clips = (count(&left_out, "clip_operations"), count(&sorted, "clip_operations"));
     assert!(4 * clips.0 < clips.1, "{clips:?} clips");
     assert_light_agree(&scene, &reference(&scene), &left_out.frame, "backgrounds left out against ray-cast");
+}
+
+/// Atherton-Weiler-Greenberg takes the polygons of the generated spheres that nothing else
+/// in the light view meets out of the sort (each sphere's side facing the light is one
+/// sheet), and lights the floor under them, a wide background, with their outlines as
+/// holes: most of the polygons facing the light leave the sort, far fewer clips are made,
+/// the whole polygons make no edges in the view pass, and the light is ray-cast's at every
+/// pixel. Without backgrounds the floor meets every sphere, and none is lone.
+#[test]
+fn lone_sheets_leave_the_sort() {
+    use umbra::shadow::AthertonWeilerGreenbergOptions;
+    let scene = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
+    let awg = |backgrounds, lone_sheets| {
+        let options = AthertonWeilerGreenbergOptions { convex_split: true, backgrounds, lone_sheets };
+        let shadows = ShadowMethod::AthertonWeilerGreenberg(options);
+        umbra::render(&scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
+    };
+    let (lone, sorted, floor_meets) = (awg(true, true), awg(true, false), awg(false, true));
+    let count = |r: &umbra::Rendered, c: &str| r.stats.shadow_counters.get(c);
+    // About half of the five spheres' 3,000 triangles face the light.
+    assert!(count(&lone, "light_view_lone") > 3000 / 3, "{} lone", count(&lone, "light_view_lone"));
+    assert_eq!(count(&sorted, "light_view_lone"), 0);
+    assert_eq!(count(&floor_meets, "light_view_lone"), 0);
+    let clips = (count(&lone, "clip_operations"), count(&sorted, "clip_operations"));
+    assert!(2 * clips.0 < clips.1, "{clips:?} clips");
+    let in_view = (count(&lone, "detail_polygons_in_view"), count(&sorted, "detail_polygons_in_view"));
+    assert!(in_view.0 > 0 && in_view.0 <= in_view.1, "{in_view:?} detail polygons in view");
+    assert_light_agree(&scene, &reference(&scene), &lone.frame, "lone sheets against ray-cast");
+    assert_light_agree(&scene, &reference(&scene), &floor_meets.frame, "no backgrounds against ray-cast");
 }
 
 /// Merged shadow volumes leave out the polygons of closed solids turned away from the light
