@@ -29,7 +29,7 @@ use super::{AthertonWeilerGreenbergOptions, ShadowContext, ShadowStage, ShadowWa
 use crate::error::{Error, Result};
 use crate::geometry::convex_split::{self, is_convex};
 use crate::geometry::lone_sheets::{self, Item, NO_ITEM};
-use crate::geometry::weiler_atherton::{clip, regions_apart, signed_area, ClipError, Region, Ring};
+use crate::geometry::weiler_atherton::{clip, regions_apart, ring_bounds, signed_area, ClipError, Region, Ring};
 use crate::geometry::{clip_in_place, clip_polygon, even_odd, grid_cells, Plane};
 use crate::scene::{LightSample, ObjText, Scene};
 use crate::stats::Counters;
@@ -86,14 +86,18 @@ impl Piece {
     }
 
     fn overlaps(&self, other: &Piece) -> bool {
-        let (a, b) = (self.bounds, other.bounds);
-        a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y
+        boxes_meet(self.bounds, other.bounds)
     }
 
     /// The nearest any of its vertices gets (the rough sort's key).
     fn nearest(&self) -> f64 {
         self.region.rings.iter().flatten().map(|p| self.near.inv_z(p.x, p.y)).fold(f64::NEG_INFINITY, f64::max)
     }
+}
+
+/// Whether two boxes (least, greatest corner) meet, edges included.
+fn boxes_meet(a: (DVec2, DVec2), b: (DVec2, DVec2)) -> bool {
+    a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y
 }
 
 /// Pass 1's setting and counters.
@@ -144,12 +148,17 @@ enum Relation {
 }
 
 fn relation(q: &Piece, clip: &Piece) -> Relation {
+    relation_at(q.region.rings.iter().flatten().copied(), &q.near, &clip.near)
+}
+
+/// How a polygon with corners `points` and nearness `near` lies relative to another's
+/// plane `clip` over the polygon's own area.
+fn relation_at(points: impl Iterator<Item = DVec2> + Clone, near: &DepthPlane, clip: &DepthPlane) -> Relation {
     let (mut front, mut behind) = (false, false);
-    let scale =
-        q.region.rings.iter().flatten().map(|p| clip.near.inv_z(p.x, p.y).abs()).fold(0.0, f64::max).max(1e-300);
+    let scale = points.clone().map(|p| clip.inv_z(p.x, p.y).abs()).fold(0.0, f64::max).max(1e-300);
     let tol = 1e-9 * scale;
-    for p in q.region.rings.iter().flatten() {
-        let d = q.near.inv_z(p.x, p.y) - clip.near.inv_z(p.x, p.y);
+    for p in points {
+        let d = near.inv_z(p.x, p.y) - clip.inv_z(p.x, p.y);
         front |= d > tol;
         behind |= d < -tol;
     }
@@ -456,9 +465,17 @@ impl LightView {
     }
 
     /// Polygon `verts` cut to this view (for a cube face, its frustum) and mapped into it,
-    /// with its nearness function and whether nothing was cut off; `None` when nothing is
-    /// left or it is edge-on.
-    fn map(&self, verts: &[DVec3], plane: &Plane, near: f64) -> Option<(Vec<DVec2>, DepthPlane, bool)> {
+    /// its corners added to `out`; its nearness function and whether nothing was cut off, or
+    /// `None` (and nothing added) when nothing is left or it is edge-on. `scratch` is room
+    /// for the cut.
+    fn map_into(
+        &self,
+        verts: &[DVec3],
+        plane: &Plane,
+        near: f64,
+        out: &mut Vec<DVec2>,
+        scratch: &mut [Vec<DVec3>; 2],
+    ) -> Option<(DepthPlane, bool)> {
         match *self {
             LightView::Face { light, axis, e1, e2 } => {
                 // The frustum |p·e1|, |p·e2| <= p·axis, and a tiny near plane at the light.
@@ -475,10 +492,13 @@ impl LightView {
                     return None;
                 }
                 let whole = planes.iter().all(|f| verts.iter().all(|&v| f(v - light) >= 0.0));
-                let mut a: Vec<DVec3> = verts.iter().map(|&v| v - light).collect();
-                let mut b = Vec::new();
-                for f in planes {
-                    clip_in_place(&mut a, &mut b, f);
+                let [a, b] = scratch;
+                a.clear();
+                a.extend(verts.iter().map(|&v| v - light));
+                if !whole {
+                    for f in planes {
+                        clip_in_place(a, b, f);
+                    }
                 }
                 if a.len() < 3 {
                     return None;
@@ -491,7 +511,8 @@ impl LightView {
                 }
                 let n = plane.n;
                 let near_fn = DepthPlane { a: -n.dot(e1) / k, b: -n.dot(e2) / k, c: -n.dot(axis) / k };
-                Some((a.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2)) / p.dot(axis)).collect(), near_fn, whole))
+                out.extend(a.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2)) / p.dot(axis)));
+                Some((near_fn, whole))
             }
             LightView::Parallel { d, e1, e2 } => {
                 // The plane's point at (u, v) is u e1 + v e2 + s d with s = −(n·(u e1 + v e2) + d0)/(n·d);
@@ -501,7 +522,8 @@ impl LightView {
                     return None;
                 }
                 let near_fn = DepthPlane { a: plane.n.dot(e1) / nd, b: plane.n.dot(e2) / nd, c: plane.d / nd };
-                Some((verts.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2))).collect(), near_fn, true))
+                out.extend(verts.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2))));
+                Some((near_fn, true))
             }
         }
     }
@@ -522,12 +544,12 @@ impl LightView {
 }
 
 /// A polygon's region for the clipper, whose rings must not cross themselves: a
-/// self-intersecting outline (inside by the even-odd rule) becomes the trapezoids of its
-/// even-odd region ([`crate::geometry::even_odd`]), which touch but never cross. Also
-/// whether it was.
-fn even_odd_region(ring: Vec<DVec2>) -> (Region, bool) {
-    if !even_odd::self_intersects(&ring) {
-        return (Region::from_ring(ring), false);
+/// self-intersecting outline (`crossing`; inside by the even-odd rule) becomes the
+/// trapezoids of its even-odd region ([`crate::geometry::even_odd`]), which touch but never
+/// cross.
+fn even_odd_region(ring: Vec<DVec2>, crossing: bool) -> Region {
+    if !crossing {
+        return Region::from_ring(ring);
     }
     let rings = even_odd::trapezoids(&ring)
         .into_iter()
@@ -537,7 +559,107 @@ fn even_odd_region(ring: Vec<DVec2>) -> (Region, bool) {
             (r.len() >= 3).then_some(r)
         })
         .collect();
-    (Region { rings }, true)
+    Region { rings }
+}
+
+/// The polygons of one light view, mapped into it (step 1(a)): their outlines side by side
+/// in one list, so that the many polygons of a view cost no allocation each; most of them
+/// leave as lone ([`take_lone`]) without ever becoming [`Piece`]s.
+#[derive(Debug, Default)]
+struct Mapped {
+    points: Vec<DVec2>,
+    polys: Vec<MappedPolygon>,
+}
+
+/// One polygon of a [`Mapped`] view.
+#[derive(Debug, Clone, Copy)]
+struct MappedPolygon {
+    source: u32,
+    /// Its outline: `points[first..first + len]`.
+    first: u32,
+    len: u32,
+    near: DepthPlane,
+    bounds: (DVec2, DVec2),
+    /// The outline crosses itself.
+    crossing: bool,
+    /// The outline is the whole source polygon, its corners in order, and does not cross
+    /// itself.
+    whole: bool,
+    casts: bool,
+}
+
+impl Mapped {
+    /// The polygons of `scene` that `view` may see (`unseen` left out), mapped in parallel,
+    /// in order.
+    fn new(scene: &Scene, unseen: &[bool], view: LightView, extent: f64) -> Mapped {
+        let parts: Vec<Mapped> = (0..scene.polygons.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .fold(
+                || (Mapped::default(), [Vec::new(), Vec::new()]),
+                |(mut m, mut scratch), i| {
+                    if !unseen[i] {
+                        m.push(scene, view, i, 1e-9 * extent, &mut scratch);
+                    }
+                    (m, scratch)
+                },
+            )
+            .map(|(m, _)| m)
+            .collect();
+        let mut all = Mapped {
+            points: Vec::with_capacity(parts.iter().map(|m| m.points.len()).sum()),
+            polys: Vec::with_capacity(parts.iter().map(|m| m.polys.len()).sum()),
+        };
+        for part in parts {
+            let base = all.points.len() as u32;
+            all.points.extend(part.points);
+            all.polys.extend(part.polys.into_iter().map(|p| MappedPolygon { first: p.first + base, ..p }));
+        }
+        all
+    }
+
+    /// Maps polygon `i` of `scene`, if the view sees any of it.
+    fn push(&mut self, scene: &Scene, view: LightView, i: usize, near: f64, scratch: &mut [Vec<DVec3>; 2]) {
+        let first = self.points.len();
+        let Some((near, cut_whole)) =
+            view.map_into(scene.verts(i), &scene.polygons[i].plane, near, &mut self.points, scratch)
+        else {
+            return;
+        };
+        let ring = &self.points[first..];
+        let Some(bounds) = ring_bounds(ring) else { return };
+        let crossing = ring.len() >= 4 && even_odd::self_intersects(ring);
+        self.polys.push(MappedPolygon {
+            source: i as u32,
+            first: first as u32,
+            len: ring.len() as u32,
+            near,
+            bounds,
+            crossing,
+            whole: cut_whole && !crossing,
+            casts: scene.casts_shadows(i),
+        });
+    }
+
+    fn ring(&self, p: &MappedPolygon) -> &[DVec2] {
+        &self.points[p.first as usize..(p.first + p.len) as usize]
+    }
+
+    /// Polygon `p` as a piece for the sort.
+    fn piece(&self, p: &MappedPolygon) -> Option<Piece> {
+        let mut piece = Piece::new(p.source, even_odd_region(self.ring(p).to_vec(), p.crossing), p.near)?;
+        piece.whole = p.whole;
+        Some(piece)
+    }
+
+    /// The pieces of the polygons that `keep` keeps, casters and others apart, in order.
+    fn pieces(&self, keep: impl Fn(usize) -> bool + Sync) -> (Vec<Piece>, Vec<Piece>) {
+        let of = |casts: bool| {
+            let all = self.polys.par_iter().enumerate();
+            all.filter(|(i, p)| p.casts == casts && keep(*i)).filter_map(|(_, p)| self.piece(p)).collect()
+        };
+        (of(true), of(false))
+    }
 }
 
 /// Steps 1(a)-(c) and 2 for one view of one light sample: the scene mapped into the view,
@@ -549,34 +671,13 @@ fn lit_in_view(
     extent: f64,
     stats: &mut Pass1,
 ) -> std::result::Result<Vec<DetailPolygon>, ClipError> {
-    // The polygons mapped into the view in parallel, kept in order.
-    let mapped: Vec<(Piece, bool)> = (0..scene.polygons.len())
-        .into_par_iter()
-        .filter(|&i| !unseen[i])
-        .filter_map(|i| {
-            let (ring, near, whole) = view.map(scene.verts(i), &scene.polygons[i].plane, 1e-9 * extent)?;
-            let (region, crossing) = even_odd_region(ring);
-            let mut piece = Piece::new(i as u32, region, near)?;
-            piece.whole = whole && !crossing;
-            Some((piece, scene.casts_shadows(i)))
-        })
-        .collect();
-    let (mut casters, mut others) = (Vec::new(), Vec::new());
-    for (piece, casts) in mapped {
-        if casts {
-            casters.push(piece);
-        } else {
-            others.push(piece);
-        }
-    }
-    // Lone pieces and wide backgrounds leave the view before it is cut (ours).
-    let (casters, lone) = if stats.lone_sheets {
-        take_lone(scene, casters, &others, stats.backgrounds)
-    } else {
-        (casters, LoneSplit::default())
-    };
+    let mapped = Mapped::new(scene, unseen, view, extent);
+    // Lone polygons and wide backgrounds leave the view before it is cut (ours).
+    let lone = if stats.lone_sheets { take_lone(scene, &mapped, stats.backgrounds) } else { LoneSplit::default() };
     stats.lone += lone.lone.len() as u64;
     stats.backgrounds_found += lone.behind.len() as u64;
+    let (casters, others) = mapped.pieces(|i| lone.sorted.get(i) != Some(&false));
+    drop(mapped);
     // Independent regions of the view (one, for up to TILE_PIECES casters), sorted in
     // parallel.
     let all = casters.iter().chain(&others).map(|p| p.bounds);
@@ -617,43 +718,49 @@ fn lit_in_view(
     // The wide backgrounds, lit where no visible piece or lone sheet covers them.
     let over: Vec<&Piece> = cover.iter().chain(&lone.outlines).collect();
     let behind: Vec<Piece> = lone.behind.into_par_iter().filter_map(|b| holed(b, over.iter().copied())).collect();
-    detail.par_extend(behind.into_par_iter().chain(lone.lone).map(unmap));
+    detail.par_extend(behind.into_par_iter().map(unmap));
+    let whole = |source: u32| DetailPolygon { source, rings: vec![scene.verts(source as usize).to_vec()] };
+    detail.par_extend(lone.lone.into_par_iter().map(whole));
     Ok(detail)
 }
 
 /// What the lone-sheet step (ours) takes out of a light view before it is cut into regions.
 #[derive(Debug, Default)]
 struct LoneSplit {
-    /// Pieces that nothing else in the view meets ([`lone_sheets`]): wholly lit, and they
-    /// hide nothing but wide backgrounds.
-    lone: Vec<Piece>,
-    /// The outlines of the lone pieces, sheet by sheet: the holes they make in `behind`.
+    /// The polygons (by source) that nothing else in the view meets ([`lone_sheets`]):
+    /// wholly lit, and they hide nothing but wide backgrounds.
+    lone: Vec<u32>,
+    /// The outlines of the lone polygons, sheet by sheet: the holes they make in `behind`.
     outlines: Vec<Piece>,
     /// Wide backgrounds ([`wide_backgrounds`]), lit last.
     behind: Vec<Piece>,
+    /// `sorted[i]`: whether mapped polygon `i` is neither, and goes on to the sort.
+    sorted: Vec<bool>,
 }
 
 /// Step 1(b), ours, before the sort: the casters no other polygon in the view meets leave
 /// it, found sheet by sheet ([`lone_sheets`]: the side of a closed mesh that faces the light
 /// is one sheet, whose polygons never overlap one another), and so do wide backgrounds,
-/// which would otherwise meet everything over them. Returns the casters left.
-fn take_lone(scene: &Scene, casters: Vec<Piece>, others: &[Piece], backgrounds: bool) -> (Vec<Piece>, LoneSplit) {
+/// which would otherwise meet everything over them.
+fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
+    let n = m.polys.len();
     let behind =
-        if backgrounds && others.is_empty() { wide_backgrounds(scene, &casters) } else { vec![false; casters.len()] };
-    let kept: Vec<usize> = (0..casters.len()).filter(|&i| !behind[i]).collect();
-    // The items across each whole piece's edges, by their places among the kept.
+        if backgrounds && m.polys.iter().all(|p| p.casts) { wide_backgrounds(scene, m) } else { vec![false; n] };
+    let kept: Vec<usize> = (0..n).filter(|&i| !behind[i]).collect();
+    // The items across each whole caster's edges, by their places among the kept.
+    let sheet = |p: &MappedPolygon| p.casts && p.whole;
     let local: FxHashMap<u32, u32> = kept
         .iter()
         .enumerate()
-        .filter(|(_, &i)| casters[i].whole)
-        .map(|(k, &i)| (casters[i].source, k as u32))
+        .filter(|(_, &i)| sheet(&m.polys[i]))
+        .map(|(k, &i)| (m.polys[i].source, k as u32))
         .collect();
     let mut across = Vec::new();
     let mut first = Vec::with_capacity(kept.len());
     for &i in &kept {
         first.push(across.len());
-        if casters[i].whole {
-            let near = scene.across(casters[i].source as usize);
+        if sheet(&m.polys[i]) {
+            let near = scene.across(m.polys[i].source as usize);
             across.extend(near.iter().map(|q| local.get(q).copied().unwrap_or(NO_ITEM)));
         }
     }
@@ -661,64 +768,58 @@ fn take_lone(scene: &Scene, casters: Vec<Piece>, others: &[Piece], backgrounds: 
         .iter()
         .zip(&first)
         .map(|(&i, &f)| {
-            let p = &casters[i];
-            let sheet = p.whole.then(|| (p.region.rings[0].as_slice(), &across[f..f + p.region.rings[0].len()]));
-            Item { bounds: p.bounds, sheet }
+            let p = &m.polys[i];
+            Item { bounds: p.bounds, sheet: sheet(p).then(|| (m.ring(p), &across[f..f + p.len as usize])) }
         })
-        .chain(others.iter().map(|p| Item { bounds: p.bounds, sheet: None }))
         .collect();
     let found = lone_sheets::find(&items);
     let outlines = found
         .outlines
         .into_iter()
         .filter_map(|(one, rings)| {
-            let p = &casters[kept[one as usize]];
+            let p = &m.polys[kept[one as usize]];
             Piece::new(p.source, Region { rings }, p.near)
         })
         .collect();
-    let mut is_lone = vec![false; casters.len()];
-    for (k, &i) in kept.iter().enumerate() {
-        is_lone[i] = found.lone[k];
+    let mut sorted: Vec<bool> = behind.iter().map(|&b| !b).collect();
+    let mut lone = Vec::new();
+    for (&i, _) in kept.iter().zip(&found.lone).filter(|(_, &l)| l) {
+        sorted[i] = false;
+        lone.push(m.polys[i].source);
     }
-    let mut split = LoneSplit { outlines, ..Default::default() };
-    let mut rest = Vec::with_capacity(casters.len());
-    for (i, p) in casters.into_iter().enumerate() {
-        match (behind[i], is_lone[i]) {
-            (true, _) => split.behind.push(p),
-            (_, true) => split.lone.push(p),
-            _ => rest.push(p),
-        }
-    }
-    (rest, split)
+    let behind = (0..n).filter(|&i| behind[i]).filter_map(|i| m.piece(&m.polys[i])).collect();
+    LoneSplit { lone, outlines, behind, sorted }
 }
 
 /// Most wide polygons a light view tries as backgrounds.
 const WIDE_TRIED: usize = 16;
 
-/// `behind[i]`: whether caster `i` is a wide background (ours): convex, not a piece of a
-/// fan, with a box at least 1/64 of the view's, and every other caster whose box meets its
-/// box lies inside it and wholly in front of it. It hides nothing and is met by everything
-/// over it; left out of the regions, it is lit at the end, the visible pieces over it cut
-/// out as holes.
-fn wide_backgrounds(scene: &Scene, casters: &[Piece]) -> Vec<bool> {
-    let mut behind = vec![false; casters.len()];
-    let Some((lo, hi)) = casters.iter().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else {
+/// `behind[i]`: whether mapped caster `i` is a wide background (ours): convex, not a piece
+/// of a fan, with a box at least 1/64 of the view's, and every other caster whose box meets
+/// its box lies inside it and wholly in front of it. It hides nothing and is met by
+/// everything over it; left out of the regions, it is lit at the end, the visible pieces
+/// over it cut out as holes.
+fn wide_backgrounds(scene: &Scene, m: &Mapped) -> Vec<bool> {
+    let mut behind = vec![false; m.polys.len()];
+    let Some((lo, hi)) = m.polys.iter().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else {
         return behind;
     };
     let area = |b: (DVec2, DVec2)| (b.1 - b.0).x * (b.1 - b.0).y;
-    let mut wide: Vec<usize> = (0..casters.len())
-        .filter(|&i| casters[i].convex && area(casters[i].bounds) * 64.0 >= area((lo, hi)))
-        .filter(|&i| !scene.fan_piece(casters[i].source as usize))
+    let mut wide: Vec<usize> = (0..m.polys.len())
+        .filter(|&i| area(m.polys[i].bounds) * 64.0 >= area((lo, hi)))
+        .filter(|&i| !m.polys[i].crossing && is_convex(m.ring(&m.polys[i])))
+        .filter(|&i| !scene.fan_piece(m.polys[i].source as usize))
         .collect();
-    wide.sort_unstable_by(|&a, &b| area(casters[b].bounds).total_cmp(&area(casters[a].bounds)));
+    wide.sort_unstable_by(|&a, &b| area(m.polys[b].bounds).total_cmp(&area(m.polys[a].bounds)));
     for &w in wide.iter().take(WIDE_TRIED) {
-        let b = &casters[w];
-        let ring = &b.region.rings[0];
-        behind[w] = casters.par_iter().enumerate().all(|(i, q)| {
-            let points = || q.region.rings.iter().flatten().copied();
+        let b = &m.polys[w];
+        let ring = m.ring(b);
+        behind[w] = m.polys.par_iter().enumerate().all(|(i, q)| {
+            let points = || m.ring(q).iter().copied();
             i == w
-                || !q.overlaps(b)
-                || (convex_split::holds(ring, points()) && matches!(relation(q, b), Relation::Front))
+                || !boxes_meet(q.bounds, b.bounds)
+                || (convex_split::holds(ring, points())
+                    && matches!(relation_at(points(), &q.near, &b.near), Relation::Front))
         });
     }
     behind
