@@ -246,9 +246,13 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
         let Some(front) = sort.arena[fi as usize].take() else { continue };
         // The front polygon's outline splits everything it overlaps into inside and outside.
         let mut inside = Vec::new();
-        for q in sort.overlapping(&front, fi, stats) {
-            let Some(piece) = sort.arena[q as usize].take() else { continue };
-            let Some((ins, outs)) = cut(&piece, &front, stats)? else {
+        let taken: Vec<(u32, Piece)> = sort
+            .overlapping(&front, fi, stats)
+            .into_iter()
+            .filter_map(|q| Some((q, sort.arena[q as usize].take()?)))
+            .collect();
+        for (q, piece, parts) in cut_all(taken, &front, stats)? {
+            let Some((ins, outs)) = parts else {
                 sort.arena[q as usize] = Some(piece);
                 continue;
             };
@@ -282,6 +286,43 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
     }
     stats.fragments += out.len() as u64;
     Ok(out)
+}
+
+/// Fewest pieces one front polygon cuts in parallel.
+const PARALLEL_CUTS: usize = 16;
+
+/// Each of `taken` cut by `front`'s outline ([`cut`]), in order: in parallel where there are
+/// many (a stack of polygons that all overlap one another).
+fn cut_all(
+    taken: Vec<(u32, Piece)>,
+    front: &Piece,
+    stats: &mut Pass1,
+) -> std::result::Result<Vec<(u32, Piece, Option<Parts>)>, ClipError> {
+    if taken.len() < PARALLEL_CUTS {
+        return taken
+            .into_iter()
+            .map(|(q, p)| {
+                let parts = cut(&p, front, stats)?;
+                Ok((q, p, parts))
+            })
+            .collect();
+    }
+    let flags = Pass1 { convex_split: stats.convex_split, ..Default::default() };
+    let done: Vec<(u32, Piece, Option<Parts>, Pass1)> = taken
+        .into_par_iter()
+        .map(|(q, p)| {
+            let mut st = Pass1 { ..flags };
+            let parts = cut(&p, front, &mut st)?;
+            Ok((q, p, parts, st))
+        })
+        .collect::<std::result::Result<_, ClipError>>()?;
+    Ok(done
+        .into_iter()
+        .map(|(q, p, parts, st)| {
+            stats.add(&st);
+            (q, p, parts)
+        })
+        .collect())
 }
 
 /// What is left of `piece` outside every piece of `by`.
