@@ -292,13 +292,14 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
 const PARALLEL_CUTS: usize = 16;
 
 /// Each of `taken` cut by `front`'s outline ([`cut`]), in order: in parallel where there are
-/// many (a stack of polygons that all overlap one another).
+/// many and Weiler and Atherton's clipper cuts them (a stack of polygons that all overlap
+/// one another); splits by edges are too quick to share out.
 fn cut_all(
     taken: Vec<(u32, Piece)>,
     front: &Piece,
     stats: &mut Pass1,
 ) -> std::result::Result<Vec<(u32, Piece, Option<Parts>)>, ClipError> {
-    if taken.len() < PARALLEL_CUTS {
+    if taken.len() < PARALLEL_CUTS || stats.convex_split {
         return taken
             .into_iter()
             .map(|(q, p)| {
@@ -814,6 +815,11 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
         })
         .collect();
     let found = lone_sheets::find(&items);
+    // Without lone polygons, wide backgrounds gain nothing from leaving before the cut: they
+    // stay, to be found region by region.
+    if !found.lone.contains(&true) {
+        return LoneSplit::default();
+    }
     let outlines = found
         .outlines
         .into_iter()
