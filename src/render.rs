@@ -261,9 +261,10 @@ fn frame_pass(
     bar.phase("view: clipping and projecting");
     let whole = view.solids_past_near_plane(scene);
     let eye = crate::scene::LightSample::Point(view.eye);
+    let closed = scene.closed_from(eye);
     let seen = |i: usize| {
         let solid = scene.solid_of[i] as usize;
-        !(opts.back_face_cull && whole.get(solid) == Some(&true) && scene.turned_away_on_solid(i, eye))
+        !(opts.back_face_cull && whole.get(solid) == Some(&true) && scene.turned_away_on_solid(i, eye, &closed))
     };
     let screen = view.screen_polygons_in(scene, seen, pools.stash.take());
     stats.visibility_counters.add("screen_polygons", screen.len() as u64);

@@ -16,8 +16,8 @@
 //! The outline of a sheet's lone polygons ([`Lone::outlines`]) is their union's boundary,
 //! rings whose even-odd inside is exactly that union.
 
-use super::grid_cells;
 use super::weiler_atherton::signed_area;
+use super::{grid_cells, simple};
 use glam::DVec2;
 use rustc_hash::FxHashMap;
 
@@ -205,55 +205,6 @@ fn chain_all(edges: &[(DVec2, DVec2)]) -> Vec<Vec<DVec2>> {
         }
     }
     rings
-}
-
-/// Whether a closed ring is simple: no two of its edges meet but neighbours at their shared
-/// corner, and no corner turns straight back. Edges that come within rounding of meeting
-/// count as meeting.
-fn simple(ring: &[DVec2]) -> bool {
-    let m = ring.len();
-    if m < 3 {
-        return false;
-    }
-    let (lo, hi) = ring.iter().fold((ring[0], ring[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    let tol = 1e-12 * (hi - lo).length_squared();
-    let side = |a: DVec2, b: DVec2, c: DVec2| {
-        let d = (b - a).perp_dot(c - a);
-        if d.abs() <= tol {
-            0.0
-        } else {
-            d.signum()
-        }
-    };
-    let seg = |k: usize| (ring[k], ring[(k + 1) % m]);
-    // Neighbours: the corner between them must not turn straight back.
-    for k in 0..m {
-        let ((a, b), (_, c)) = (seg(k), seg((k + 1) % m));
-        if side(a, b, c) == 0.0 && (b - a).dot(c - b) <= 0.0 {
-            return false;
-        }
-    }
-    // Others, by a sweep over the edges' x extents.
-    let mut order: Vec<usize> = (0..m).collect();
-    let x0 = |k: usize| seg(k).0.x.min(seg(k).1.x);
-    order.sort_unstable_by(|&a, &b| x0(a).total_cmp(&x0(b)));
-    let mut active: Vec<usize> = Vec::new();
-    for &k in &order {
-        let (a, b) = seg(k);
-        active.retain(|&j| seg(j).0.x.max(seg(j).1.x) >= x0(k));
-        for &j in &active {
-            if j == (k + 1) % m || k == (j + 1) % m {
-                continue;
-            }
-            let (c, d) = seg(j);
-            let boxes = a.min(b).cmple(c.max(d)).all() && c.min(d).cmple(a.max(b)).all();
-            if boxes && side(a, b, c) * side(a, b, d) <= 0.0 && side(c, d, a) * side(c, d, b) <= 0.0 {
-                return false;
-            }
-        }
-        active.push(k);
-    }
-    true
 }
 
 /// A uniform grid over the items' boxes whose cells hold one owner each.
@@ -466,23 +417,5 @@ mod tests {
         let its: Vec<Item> =
             rings.iter().zip(&across).map(|(r, a)| Item { bounds: bounds(r), sheet: Some((r, a)) }).collect();
         assert!(find(&its).lone.iter().all(|&l| !l));
-    }
-
-    #[test]
-    fn simple_rings_and_crossing_ones() {
-        let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
-        assert!(simple(&square));
-        let bow = [DVec2::ZERO, DVec2::ONE, DVec2::X, DVec2::Y];
-        assert!(!simple(&bow));
-        // A corner that turns straight back, and one passed twice.
-        assert!(!simple(&[DVec2::ZERO, DVec2::X, DVec2::new(0.5, 0.0), DVec2::Y]));
-        assert!(!simple(&[
-            DVec2::ZERO,
-            DVec2::new(2.0, 0.0),
-            DVec2::ONE,
-            DVec2::new(2.0, 2.0),
-            DVec2::new(0.0, 2.0),
-            DVec2::ONE
-        ]));
     }
 }

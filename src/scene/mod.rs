@@ -32,7 +32,7 @@ pub(crate) fn lone_cr_to_lf(text: &str) -> std::borrow::Cow<'_, str> {
 
 use crate::error::{Error, Result};
 use crate::geometry::{classify_face, newell_normal, FaceShape, Plane};
-use glam::{DMat3, DMat4, DVec3, Vec3};
+use glam::{DMat3, DMat4, DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -479,8 +479,11 @@ pub struct Scene {
     pub(crate) face_count: u32,
     /// Each polygon's closed solid (an index into `solids`), or [`NO_SOLID`].
     pub(crate) solid_of: Vec<u32>,
-    /// The closed, consistently wound surfaces among the objects' polygons.
+    /// The closed, consistently wound surfaces among the objects' polygons (closed but for
+    /// holes: see `solids`).
     pub(crate) solids: Vec<Solid>,
+    /// Parallel to `solids`: each solid's holes, as the rings caps over them would run.
+    pub(crate) solid_holes: Vec<Vec<Vec<DVec3>>>,
     /// Parallel to `vertices`: the polygon across the edge from each corner to the next,
     /// where exactly one other polygon of the object runs that edge the other way (between
     /// the same welded positions), or [`NO_POLYGON`].
@@ -491,6 +494,42 @@ pub struct Scene {
     pub(crate) polygons_id: u64,
     /// The vertices' bounds, found when they change.
     bounds: Option<(DVec3, DVec3)>,
+}
+
+/// Whether solid `s` with holes `holes` is closed as seen from `from` ([`Scene::closed_from`]).
+fn closed_from(s: &Solid, holes: &[Vec<DVec3>], from: LightSample) -> bool {
+    let (axis_of, outside) = match from {
+        LightSample::Point(p) => (None, s.outside(p)),
+        LightSample::Directional(d) => (Some(d), true),
+    };
+    outside
+        && holes.iter().all(|ring| {
+            // Seen along `axis` (from the light sample to the hole's centre), with
+            // e1 × e2 = axis: a polygon turned away is wound counter-clockwise.
+            let centre = ring.iter().copied().sum::<DVec3>() / ring.len() as f64;
+            let axis = match (axis_of, from) {
+                (Some(d), _) => d,
+                (None, LightSample::Point(p)) => centre - p,
+                (None, LightSample::Directional(d)) => d,
+            };
+            let Some(axis) = crate::geometry::unit(axis) else { return false };
+            let e1 = axis.any_orthonormal_vector();
+            let e2 = axis.cross(e1);
+            let seen: Option<Vec<DVec2>> = ring
+                .iter()
+                .map(|&v| match from {
+                    LightSample::Point(p) => {
+                        let q = v - p;
+                        (q.dot(axis) > 0.0).then(|| DVec2::new(q.dot(e1), q.dot(e2)) / q.dot(axis))
+                    }
+                    LightSample::Directional(_) => Some(DVec2::new(v.dot(e1), v.dot(e2))),
+                })
+                .collect();
+            seen.is_some_and(|r| {
+                let area = crate::geometry::weiler_atherton::signed_area(&r);
+                area * s.sign > 0.0 && crate::geometry::simple(&r)
+            })
+        })
 }
 
 /// The next [`Scene::polygons_id`].
@@ -548,6 +587,7 @@ impl Scene {
             face_count: 0,
             solid_of: Vec::new(),
             solids: Vec::new(),
+            solid_holes: Vec::new(),
             across: Vec::new(),
             polygons_id: next_polygons_id(),
             bounds: None,
@@ -627,6 +667,7 @@ impl Scene {
             let found = solids::find(&corners, self.solids.len() as u32);
             self.solid_of.extend(found.solid_of);
             self.solids.extend(found.solids);
+            self.solid_holes.extend(found.holes);
             let p0 = self.polygons.len() as u32 - ranges.len() as u32;
             self.across
                 .extend(found.across.into_iter().map(|q| if q == solids::NO_SOLID { NO_POLYGON } else { p0 + q }));
@@ -774,20 +815,25 @@ impl Scene {
         &self.vertices[p.start as usize..(p.start + p.len) as usize]
     }
 
-    /// Whether polygon `i` belongs to a closed solid, turns its back to `from` (a light
-    /// sample or the eye), and `from` lies outside the solid's bounds (a directional light
-    /// always does). Seen from `from`, such a polygon is covered everywhere by a polygon of
-    /// the same solid that faces `from`, nearer along every ray (where the two meet, at
-    /// their shared edge, at the same distance): it never casts a shadow, and is never the
-    /// nearest polygon seen. Ours, not the papers'; see `docs/algorithms/bouknight-kelley.md`,
-    /// "Speed-ups that are ours", and `docs/algorithms/scanline.md`.
-    pub(crate) fn turned_away_on_solid(&self, i: usize, from: LightSample) -> bool {
-        let Some(solid) = self.solids.get(self.solid_of[i] as usize) else { return false };
-        let outside = match from {
-            LightSample::Point(s) => solid.outside(s),
-            LightSample::Directional(_) => true,
-        };
-        outside && from.side_of(&self.polygons[i].plane) * solid.sign < 0.0
+    /// `closed[s]`: whether solid `s` is closed as seen from `from` (a light sample or the
+    /// eye): `from` lies outside its bounds (a directional light always does), and each of
+    /// its holes, projected from `from`, is a simple polygon wound as a polygon turned away
+    /// from `from` is, so a cap over it could turn its back to `from` too (see `solids`).
+    /// [`Scene::turned_away_on_solid`] needs it.
+    pub(crate) fn closed_from(&self, from: LightSample) -> Vec<bool> {
+        self.solids.iter().zip(&self.solid_holes).map(|(s, holes)| closed_from(s, holes, from)).collect()
+    }
+
+    /// Whether polygon `i` belongs to a solid closed as seen from `from` (`closed`, from
+    /// [`Scene::closed_from`]) and turns its back to `from`. Seen from `from`, such a polygon
+    /// is covered everywhere by a polygon of the same solid that faces `from`, nearer along
+    /// every ray (where the two meet, at their shared edge, at the same distance): it never
+    /// casts a shadow, and is never the nearest polygon seen. Ours, not the papers'; see
+    /// `docs/algorithms/bouknight-kelley.md`, "Speed-ups that are ours", and
+    /// `docs/algorithms/scanline.md`.
+    pub(crate) fn turned_away_on_solid(&self, i: usize, from: LightSample, closed: &[bool]) -> bool {
+        let s = self.solid_of[i] as usize;
+        closed.get(s) == Some(&true) && from.side_of(&self.polygons[i].plane) * self.solids[s].sign < 0.0
     }
 
     /// Whether polygon `i` is one piece of a non-planar face split into a fan (its face has
@@ -821,6 +867,7 @@ impl Scene {
     /// the new polygons), and the polygons take a new [`Scene::polygons_id`].
     pub(crate) fn polygons_changed(&mut self) {
         self.solids.clear();
+        self.solid_holes.clear();
         self.solid_of.clear();
         self.solid_of.resize(self.polygons.len(), solids::NO_SOLID);
         self.across.clear();

@@ -12,6 +12,14 @@
 //! outside point on the side the sign names. This needs the surface not to pass through
 //! itself with parts turned inside out (a self-intersecting mesh whose winding goes
 //! negative), which a scanned or modelled closed mesh does not do.
+//!
+//! A solid may have *holes*: loops of edges used by one polygon only (a scanned mesh's
+//! unscanned patches). The argument then needs a cap over each hole that turns its back to
+//! the viewpoint, so that the surface crossed first is never a cap. Such a cap exists when
+//! the hole's loop, projected from the viewpoint, is a simple polygon wound the way a
+//! polygon turned away is (a triangulation of that polygon, lifted onto the loop's
+//! corners, is the cap); [`crate::scene::Scene::closed_from`] checks it per viewpoint, and
+//! assumes, as above, that the capped surface does not pass through itself.
 
 use glam::DVec3;
 
@@ -53,6 +61,9 @@ pub(crate) struct Found {
     /// the edge from that corner to the next, where exactly one other polygon runs that edge
     /// the other way; [`NO_SOLID`] otherwise.
     pub across: Vec<u32>,
+    /// Per solid, its holes: each loop of edges used once, as the ring a cap over it runs
+    /// (the other way round from the polygons on it).
+    pub holes: Vec<Vec<Vec<DVec3>>>,
 }
 
 /// The solids among one object's polygons (their indices in the scene's list offset by
@@ -60,28 +71,44 @@ pub(crate) struct Found {
 pub(crate) fn find(corners: &Corners, first: u32) -> Found {
     let n = corners.ranges.len();
     let mut sets = DisjointSets::new(n);
-    let mut open = vec![false; n];
+    let mut bad = vec![false; n];
     let mut across = vec![NO_SOLID; corners.keys.len()];
-    pair_edges(corners, &mut sets, &mut open, &mut across);
+    let once = pair_edges(corners, &mut sets, &mut bad, &mut across);
     for p in 0..n {
-        if open[p] {
+        if bad[p] {
             let r = sets.root(p);
-            open[r] = true;
+            bad[r] = true;
         }
     }
-    // One solid per closed component, in the order of its first polygon.
+    // Each component's holes, from its edges used once; a component whose edges used once
+    // do not make loops has none to speak of.
+    let mut loose: Vec<Vec<Edge>> = vec![Vec::new(); n];
+    for e in once {
+        let r = sets.root(e.poly as usize);
+        loose[r].push(e);
+    }
+    let mut holes_of: Vec<Vec<Vec<DVec3>>> = vec![Vec::new(); n];
+    for r in 0..n {
+        if !bad[r] && !loose[r].is_empty() {
+            match loops(&loose[r]) {
+                Some(h) => holes_of[r] = h,
+                None => bad[r] = true,
+            }
+        }
+    }
+    // One solid per component, in the order of its first polygon.
     let mut index = vec![NO_SOLID; n];
-    let mut volume: Vec<(f64, DVec3, DVec3, DVec3)> = Vec::new();
+    let mut volume: Vec<(f64, DVec3, DVec3, DVec3, usize)> = Vec::new();
     let mut of = vec![NO_SOLID; n];
     for (p, &(start, len)) in corners.ranges.iter().enumerate() {
         let r = sets.root(p);
-        if open[r] {
+        if bad[r] {
             continue;
         }
         let v = &corners.verts[start as usize..(start + len) as usize];
         if index[r] == NO_SOLID {
             index[r] = volume.len() as u32;
-            volume.push((0.0, v[0], v[0], v[0]));
+            volume.push((0.0, v[0], v[0], v[0], r));
         }
         let s = &mut volume[index[r] as usize];
         // Six times the signed volume of the cone from the component's first corner.
@@ -95,10 +122,20 @@ pub(crate) fn find(corners: &Corners, first: u32) -> Found {
         }
         of[p] = index[r];
     }
+    // The holes closed by fans from their centres count toward the volume.
+    for s in &mut volume {
+        let o = s.1;
+        for ring in &holes_of[s.4] {
+            let c = ring.iter().copied().sum::<DVec3>() / ring.len() as f64;
+            for k in 0..ring.len() {
+                s.0 += (c - o).dot((ring[k] - o).cross(ring[(k + 1) % ring.len()] - o));
+            }
+        }
+    }
     // A component that encloses (next to) no volume has no inside to speak of.
     let sign: Vec<f64> = volume
         .iter()
-        .map(|&(vol, _, lo, hi)| {
+        .map(|&(vol, _, lo, hi, _)| {
             let size = (hi - lo).length();
             if vol.abs() > 1e-9 * size * size * size {
                 vol.signum()
@@ -108,11 +145,12 @@ pub(crate) fn find(corners: &Corners, first: u32) -> Found {
         })
         .collect();
     let mut renumber = vec![NO_SOLID; volume.len()];
-    let mut solids = Vec::new();
-    for (i, &(_, _, lo, hi)) in volume.iter().enumerate() {
+    let (mut solids, mut holes) = (Vec::new(), Vec::new());
+    for (i, &(_, _, lo, hi, r)) in volume.iter().enumerate() {
         if sign[i] != 0.0 {
             renumber[i] = first + solids.len() as u32;
             solids.push(Solid { sign: sign[i], lo, hi });
+            holes.push(std::mem::take(&mut holes_of[r]));
         }
     }
     for s in &mut of {
@@ -120,13 +158,51 @@ pub(crate) fn find(corners: &Corners, first: u32) -> Found {
             *s = renumber[*s as usize];
         }
     }
-    Found { solid_of: of, solids, across }
+    Found { solid_of: of, solids, across, holes }
 }
 
-/// Joins the polygons that share an edge, marks `open` those with an edge that is not
-/// shared by exactly one other polygon running the other way, and notes in `across` (per
-/// corner) the polygon across each edge that is.
-fn pair_edges(corners: &Corners, sets: &mut DisjointSets, open: &mut [bool], across: &mut [u32]) {
+/// An edge used by one polygon only: its polygon, and its ends as welded keys and points.
+#[derive(Debug, Clone, Copy)]
+struct Edge {
+    poly: u32,
+    keys: (u32, u32),
+    ends: (DVec3, DVec3),
+}
+
+/// Edges used once chained into loops, each as the ring a cap over it runs (against the
+/// edges); `None` when a corner starts or ends more than one.
+fn loops(edges: &[Edge]) -> Option<Vec<Vec<DVec3>>> {
+    let mut from: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+    for (i, e) in edges.iter().enumerate() {
+        if from.insert(e.keys.0, i).is_some() {
+            return None;
+        }
+    }
+    let mut used = vec![false; edges.len()];
+    let mut rings = Vec::new();
+    for start in 0..edges.len() {
+        let mut ring = Vec::new();
+        let mut i = start;
+        while !used[i] {
+            used[i] = true;
+            ring.push(edges[i].ends.0);
+            i = *from.get(&edges[i].keys.1)?;
+        }
+        if !ring.is_empty() {
+            if i != start {
+                return None;
+            }
+            ring.reverse();
+            rings.push(ring);
+        }
+    }
+    Some(rings)
+}
+
+/// Joins the polygons that share an edge, marks `bad` those with an edge shared other than
+/// by exactly two polygons running it opposite ways (or no edge at all), and notes in
+/// `across` (per corner) the polygon across each edge that is; returns the edges used once.
+fn pair_edges(corners: &Corners, sets: &mut DisjointSets, bad: &mut [bool], across: &mut [u32]) -> Vec<Edge> {
     // Each edge as (lesser key, greater key, runs from the greater, polygon, its corner).
     let mut edges = Vec::new();
     for (p, &(start, len)) in corners.ranges.iter().enumerate() {
@@ -134,13 +210,14 @@ fn pair_edges(corners: &Corners, sets: &mut DisjointSets, open: &mut [bool], acr
         for k in 0..keys.len() {
             let (a, b) = (keys[k], keys[(k + 1) % keys.len()]);
             if a == b {
-                open[p] = true;
+                bad[p] = true;
                 continue;
             }
             edges.push((a.min(b), a.max(b), a > b, p as u32, start + k as u32));
         }
     }
     edges.sort_unstable();
+    let mut once = Vec::new();
     let mut i = 0;
     while i < edges.len() {
         let (a, b) = (edges[i].0, edges[i].1);
@@ -153,13 +230,23 @@ fn pair_edges(corners: &Corners, sets: &mut DisjointSets, open: &mut [bool], acr
             sets.join(group[0].3 as usize, group[1].3 as usize);
             across[group[0].4 as usize] = group[1].3;
             across[group[1].4 as usize] = group[0].3;
+        } else if let [(_, _, _, p, c)] = *group {
+            let (start, len) = corners.ranges[p as usize];
+            let k = c - start;
+            let next = start + (k + 1) % len;
+            once.push(Edge {
+                poly: p,
+                keys: (corners.keys[c as usize], corners.keys[next as usize]),
+                ends: (corners.verts[c as usize], corners.verts[next as usize]),
+            });
         } else {
             for e in group {
-                open[e.3 as usize] = true;
+                bad[e.3 as usize] = true;
             }
         }
         i = j;
     }
+    once
 }
 
 /// Union-find over polygon indices.
@@ -233,12 +320,52 @@ mod tests {
         let s = scene(&[two]);
         assert_eq!(s.solids.len(), 2);
 
-        let mut open = cube(false, DVec3::ZERO);
-        open.pop();
         let mut wrong = cube(false, DVec3::ZERO);
         wrong[2].reverse();
-        let s = scene(&[open, wrong]);
+        let s = scene(&[wrong]);
         assert!(s.solids.is_empty() && s.solid_of.iter().all(|&i| i == NO_SOLID));
+    }
+
+    /// A cube missing its face at x = 1 is a solid with one hole, closed as seen from the
+    /// side away from the hole (a cap there would turn its back) and not from the hole's
+    /// side, nor from inside its bounds; its polygons turned away are left out only where it
+    /// is closed.
+    #[test]
+    fn a_solid_with_a_hole_is_closed_only_from_where_a_cap_would_turn_away() {
+        use crate::scene::LightSample;
+        let mut open = cube(false, DVec3::ZERO);
+        open.pop();
+        let s = scene(&[open]);
+        assert_eq!(s.solids.len(), 1);
+        assert_eq!(s.solid_holes[0].len(), 1);
+        assert_eq!(s.solid_holes[0][0].len(), 4);
+        let from = |p: DVec3| s.closed_from(LightSample::Point(p))[0];
+        assert!(from(DVec3::new(-5.0, 0.3, 0.4)));
+        assert!(!from(DVec3::new(5.0, 0.3, 0.4)));
+        assert!(!from(DVec3::new(0.5, 0.5, 0.5)));
+        assert!(s.closed_from(LightSample::Directional(DVec3::X))[0]);
+        assert!(!s.closed_from(LightSample::Directional(DVec3::NEG_X))[0]);
+        // Seen from x = -5, the face at x = 0 faces the viewpoint and the one at z = 1 (the
+        // second) turns away from a viewpoint at z = -3.
+        let p = LightSample::Point(DVec3::new(-5.0, 0.3, -3.0));
+        let closed = s.closed_from(p);
+        assert!(!s.turned_away_on_solid(4, p, &closed) && s.turned_away_on_solid(1, p, &closed));
+        let q = LightSample::Point(DVec3::new(5.0, 0.3, -3.0));
+        assert!(!s.turned_away_on_solid(1, q, &s.closed_from(q)));
+    }
+
+    /// Edges used once that pass a corner twice (a figure eight) make no hole to cap; a
+    /// triangle's make one, run the other way round.
+    #[test]
+    fn holes_are_simple_chains_of_edges_used_once() {
+        use super::{loops, Edge};
+        let p = |k: u32| DVec3::new(k as f64, (k * k) as f64, 0.0);
+        let edge = |a: u32, b: u32| Edge { poly: 0, keys: (a, b), ends: (p(a), p(b)) };
+        let eight = [edge(0, 1), edge(1, 2), edge(2, 0), edge(0, 3), edge(3, 4), edge(4, 0)];
+        assert!(loops(&eight).is_none());
+        let triangle = [edge(0, 1), edge(1, 2), edge(2, 0)];
+        assert_eq!(loops(&triangle), Some(vec![vec![p(2), p(1), p(0)]]));
+        assert!(loops(&[edge(0, 1), edge(1, 2)]).is_none(), "a chain that does not close");
     }
 
     /// Two closed cubes that share a face (four polygons on one edge) are not solids.

@@ -98,10 +98,11 @@ fn shadow_polygons(
         .filter(|&i| ctx.visible[i as usize] && sample.on_seen_side(&scene.polygons[i as usize].plane, ctx.view.eye))
         .collect();
     let casting = |i: usize| scene.casts_shadows(i) && !edge_on(scene, i, sample, ctx.extent);
+    let closed = scene.closed_from(sample);
     let (casters, dropped): (Vec<u32>, Vec<u32>) = (0..n as u32)
         .into_par_iter()
         .filter(|&i| casting(i as usize))
-        .partition(|&i| !(options.solid_cull && faces_away_on_solid(scene, i as usize, sample)));
+        .partition(|&i| !(options.solid_cull && faces_away_on_solid(scene, i as usize, sample, &closed)));
     if options.solid_cull {
         counters.add("casters_dropped_facing_away", dropped.len() as u64);
     }

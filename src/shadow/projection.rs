@@ -30,8 +30,8 @@ pub fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> boo
 /// sample lies outside the solid's bounds: such a polygon never needs to cast, since a
 /// shadow ray that crosses it has crossed, nearer the light, a polygon of the same solid
 /// that faces the light ([`Scene::turned_away_on_solid`]).
-pub fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample) -> bool {
-    scene.turned_away_on_solid(i, sample)
+pub fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample, closed: &[bool]) -> bool {
+    scene.turned_away_on_solid(i, sample, closed)
 }
 
 /// `unseen[i]`: whether light sample `sample` need not consider polygon `i`, found in
@@ -41,9 +41,10 @@ pub fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample) -> bool
 /// light do not; ours, not the papers').
 pub fn unseen(scene: &Scene, sample: LightSample, extent: f64, cull: bool) -> Vec<bool> {
     use rayon::prelude::*;
+    let closed = if cull { scene.closed_from(sample) } else { Vec::new() };
     (0..scene.polygons.len())
         .into_par_iter()
-        .map(|i| edge_on(scene, i, sample, extent) || (cull && faces_away_on_solid(scene, i, sample)))
+        .map(|i| edge_on(scene, i, sample, extent) || faces_away_on_solid(scene, i, sample, &closed))
         .collect()
 }
 
