@@ -6,7 +6,7 @@
 //! from the light. Over a point off the edges, the number of the sheet's polygons is the
 //! winding number of the sheet's boundary around it, because each shared edge is run once
 //! each way and cancels. So when the boundary is one simple loop, wound as the polygons are,
-//! no two polygons of the sheet overlap ([`sheet_loop`] checks this).
+//! no two polygons of the sheet overlap ([`clears_itself`] checks this).
 //!
 //! A polygon of such a sheet is *lone* when every cell of a uniform grid that its bounding
 //! box meets is met by no other polygon's box but those of its own sheet: then nothing that
@@ -58,8 +58,7 @@ pub(crate) fn find(items: &[Item]) -> Lone {
     for i in (0..n).filter(|&i| root[i] != NO_ITEM) {
         members.entry(root[i]).or_default().push(i as u32);
     }
-    let valid: FxHashMap<u32, bool> =
-        members.iter().map(|(&r, m)| (r, sheet_loop(items, &root, m).is_some())).collect();
+    let valid: FxHashMap<u32, bool> = members.iter().map(|(&r, m)| (r, clears_itself(items, &root, m))).collect();
     // The grid: each cell holds the one owner whose boxes meet it, or CONFLICT.
     let owner = |i: usize| if root[i] != NO_ITEM && valid[&root[i]] { root[i] } else { (n + i) as u32 };
     let Some(grid) = Grid::new(items, owner) else { return lone };
@@ -128,16 +127,15 @@ fn boundary(items: &[Item], members: &[u32], keep: impl Fn(u32) -> bool) -> Vec<
     edges
 }
 
-/// The boundary of sheet `members` as one simple loop wound as its polygons are, or `None`
-/// when it is not (several loops, a corner passed twice, edges that meet or cross).
-fn sheet_loop(items: &[Item], root: &[u32], members: &[u32]) -> Option<Vec<DVec2>> {
+/// Whether the boundary of sheet `members` is one simple loop wound as its polygons are
+/// (not several loops, a corner passed twice, or edges that meet or cross): then no two of
+/// its polygons overlap.
+fn clears_itself(items: &[Item], root: &[u32], members: &[u32]) -> bool {
     let r = root[members[0] as usize];
     let edges = boundary(items, members, |j| root[j as usize] == r);
-    let rings = chain(&edges)?;
-    let [ring] = &rings[..] else { return None };
-    let (first, _) = items[members[0] as usize].sheet?;
-    let same_way = signed_area(ring) * signed_area(first) > 0.0;
-    (same_way && simple(ring)).then(|| ring.clone())
+    let Some(rings) = chain(&edges) else { return false };
+    let ([ring], Some((first, _))) = (&rings[..], items[members[0] as usize].sheet) else { return false };
+    signed_area(ring) * signed_area(first) > 0.0 && simple(ring)
 }
 
 /// The rings of the union of `members` that are lone.

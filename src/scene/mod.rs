@@ -32,7 +32,7 @@ pub(crate) fn lone_cr_to_lf(text: &str) -> std::borrow::Cow<'_, str> {
 
 use crate::error::{Error, Result};
 use crate::geometry::{classify_face, newell_normal, FaceShape, Plane};
-use glam::{DMat3, DMat4, DVec2, DVec3, Vec3};
+use glam::{DMat3, DMat4, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -496,42 +496,6 @@ pub struct Scene {
     bounds: Option<(DVec3, DVec3)>,
 }
 
-/// Whether solid `s` with holes `holes` is closed as seen from `from` ([`Scene::closed_from`]).
-fn closed_from(s: &Solid, holes: &[Vec<DVec3>], from: LightSample) -> bool {
-    let (axis_of, outside) = match from {
-        LightSample::Point(p) => (None, s.outside(p)),
-        LightSample::Directional(d) => (Some(d), true),
-    };
-    outside
-        && holes.iter().all(|ring| {
-            // Seen along `axis` (from the light sample to the hole's centre), with
-            // e1 × e2 = axis: a polygon turned away is wound counter-clockwise.
-            let centre = ring.iter().copied().sum::<DVec3>() / ring.len() as f64;
-            let axis = match (axis_of, from) {
-                (Some(d), _) => d,
-                (None, LightSample::Point(p)) => centre - p,
-                (None, LightSample::Directional(d)) => d,
-            };
-            let Some(axis) = crate::geometry::unit(axis) else { return false };
-            let e1 = axis.any_orthonormal_vector();
-            let e2 = axis.cross(e1);
-            let seen: Option<Vec<DVec2>> = ring
-                .iter()
-                .map(|&v| match from {
-                    LightSample::Point(p) => {
-                        let q = v - p;
-                        (q.dot(axis) > 0.0).then(|| DVec2::new(q.dot(e1), q.dot(e2)) / q.dot(axis))
-                    }
-                    LightSample::Directional(_) => Some(DVec2::new(v.dot(e1), v.dot(e2))),
-                })
-                .collect();
-            seen.is_some_and(|r| {
-                let area = crate::geometry::weiler_atherton::signed_area(&r);
-                area * s.sign > 0.0 && crate::geometry::simple(&r)
-            })
-        })
-}
-
 /// The next [`Scene::polygons_id`].
 static NEXT_POLYGONS_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
@@ -821,7 +785,7 @@ impl Scene {
     /// from `from` is, so a cap over it could turn its back to `from` too (see `solids`).
     /// [`Scene::turned_away_on_solid`] needs it.
     pub(crate) fn closed_from(&self, from: LightSample) -> Vec<bool> {
-        self.solids.iter().zip(&self.solid_holes).map(|(s, holes)| closed_from(s, holes, from)).collect()
+        self.solids.iter().zip(&self.solid_holes).map(|(s, holes)| solids::closed_from(s, holes, from)).collect()
     }
 
     /// Whether polygon `i` belongs to a solid closed as seen from `from` (`closed`, from

@@ -21,7 +21,10 @@
 //! corners, is the cap); [`crate::scene::Scene::closed_from`] checks it per viewpoint, and
 //! assumes, as above, that the capped surface does not pass through itself.
 
-use glam::DVec3;
+use super::LightSample;
+use crate::geometry::weiler_atherton::signed_area;
+use crate::geometry::{simple, unit};
+use glam::{DVec2, DVec3};
 
 /// No solid: the polygon is on an open or non-manifold part of its mesh.
 pub(crate) const NO_SOLID: u32 = u32::MAX;
@@ -41,6 +44,43 @@ impl Solid {
     pub fn outside(&self, p: DVec3) -> bool {
         p.cmplt(self.lo).any() || p.cmpgt(self.hi).any()
     }
+}
+
+/// Whether `solid`, with holes `holes`, is closed as seen from `from`: `from` lies outside
+/// its bounds (a directional light always does), and each hole, projected from `from`, is
+/// a simple polygon wound as a polygon turned away from `from` is (see the module's notes).
+pub(crate) fn closed_from(solid: &Solid, holes: &[Vec<DVec3>], from: LightSample) -> bool {
+    let outside = match from {
+        LightSample::Point(p) => solid.outside(p),
+        LightSample::Directional(_) => true,
+    };
+    outside
+        && holes
+            .iter()
+            .all(|ring| seen_from(from, ring).is_some_and(|r| signed_area(&r) * solid.sign > 0.0 && simple(&r)))
+}
+
+/// `ring` projected from `from` onto a plane across the line of sight to its centre, on
+/// axes `e1`, `e2` with `e1 × e2` pointing away from `from`: a polygon turned away from
+/// `from` comes out counter-clockwise. `None` when a corner is not in front of `from`.
+fn seen_from(from: LightSample, ring: &[DVec3]) -> Option<Vec<DVec2>> {
+    let centre = ring.iter().copied().sum::<DVec3>() / ring.len() as f64;
+    let axis = unit(match from {
+        LightSample::Point(p) => centre - p,
+        LightSample::Directional(d) => d,
+    })?;
+    let e1 = axis.any_orthonormal_vector();
+    let e2 = axis.cross(e1);
+    ring.iter()
+        .map(|&v| match from {
+            LightSample::Point(p) => {
+                let q = v - p;
+                let depth = q.dot(axis);
+                (depth > 0.0).then(|| DVec2::new(q.dot(e1), q.dot(e2)) / depth)
+            }
+            LightSample::Directional(_) => Some(DVec2::new(v.dot(e1), v.dot(e2))),
+        })
+        .collect()
 }
 
 /// One polygon's corners: `keys[start..start+len]` (welded vertex ids) and the same range of
