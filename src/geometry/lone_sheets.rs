@@ -17,7 +17,7 @@
 //! rings whose even-odd inside is exactly that union.
 
 use super::weiler_atherton::signed_area;
-use super::{grid_cells, simple};
+use super::{edge_loops, grid_cells, simple};
 use glam::DVec2;
 use rustc_hash::FxHashMap;
 
@@ -156,30 +156,9 @@ fn key(p: DVec2) -> [u64; 2] {
 /// Directed edges chained into closed rings, each corner left by one edge only; `None` when
 /// a corner is left by two, or an edge leads nowhere.
 fn chain(edges: &[(DVec2, DVec2)]) -> Option<Vec<Vec<DVec2>>> {
-    let mut from: FxHashMap<[u64; 2], usize> = FxHashMap::default();
-    for (e, &(a, _)) in edges.iter().enumerate() {
-        if from.insert(key(a), e).is_some() {
-            return None;
-        }
-    }
-    let mut used = vec![false; edges.len()];
-    let mut rings = Vec::new();
-    for start in 0..edges.len() {
-        let mut ring = Vec::new();
-        let mut e = start;
-        while !used[e] {
-            used[e] = true;
-            ring.push(edges[e].0);
-            e = *from.get(&key(edges[e].1))?;
-        }
-        if !ring.is_empty() {
-            if e != start {
-                return None;
-            }
-            rings.push(ring);
-        }
-    }
-    Some(rings)
+    let ends: Vec<([u64; 2], [u64; 2])> = edges.iter().map(|&(a, b)| (key(a), key(b))).collect();
+    let loops = edge_loops(&ends)?;
+    Some(loops.into_iter().map(|l| l.into_iter().map(|e| edges[e].0).collect()).collect())
 }
 
 /// Directed edges (each corner left as often as it is reached) chained into closed rings.

@@ -227,6 +227,35 @@ pub(crate) fn grid_cells(
     (c0..=c1).flat_map(move |c| (r0..=r1).map(move |r| (c, r)))
 }
 
+/// Directed edges, given by the keys of their ends, chained into closed loops (each a list
+/// of edge indices in order); `None` when a key starts two edges or an edge leads nowhere.
+pub(crate) fn edge_loops<K: Eq + std::hash::Hash + Copy>(ends: &[(K, K)]) -> Option<Vec<Vec<usize>>> {
+    let mut from: rustc_hash::FxHashMap<K, usize> = rustc_hash::FxHashMap::default();
+    for (e, &(a, _)) in ends.iter().enumerate() {
+        if from.insert(a, e).is_some() {
+            return None;
+        }
+    }
+    let mut used = vec![false; ends.len()];
+    let mut loops = Vec::new();
+    for start in 0..ends.len() {
+        let mut chain = Vec::new();
+        let mut e = start;
+        while !used[e] {
+            used[e] = true;
+            chain.push(e);
+            e = *from.get(&ends[e].1)?;
+        }
+        if !chain.is_empty() {
+            if e != start {
+                return None;
+            }
+            loops.push(chain);
+        }
+    }
+    Some(loops)
+}
+
 /// Whether a closed ring is simple: no two of its edges meet but neighbours at their shared
 /// corner, and no corner turns straight back. Edges that come within rounding of meeting
 /// count as meeting.

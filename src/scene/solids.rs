@@ -23,7 +23,7 @@
 
 use super::LightSample;
 use crate::geometry::weiler_atherton::signed_area;
-use crate::geometry::{simple, unit};
+use crate::geometry::{edge_loops, simple, unit};
 use glam::{DVec2, DVec3};
 
 /// No solid: the polygon is on an open or non-manifold part of its mesh.
@@ -212,31 +212,9 @@ struct Edge {
 /// Edges used once chained into loops, each as the ring a cap over it runs (against the
 /// edges); `None` when a corner starts or ends more than one.
 fn loops(edges: &[Edge]) -> Option<Vec<Vec<DVec3>>> {
-    let mut from: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
-    for (i, e) in edges.iter().enumerate() {
-        if from.insert(e.keys.0, i).is_some() {
-            return None;
-        }
-    }
-    let mut used = vec![false; edges.len()];
-    let mut rings = Vec::new();
-    for start in 0..edges.len() {
-        let mut ring = Vec::new();
-        let mut i = start;
-        while !used[i] {
-            used[i] = true;
-            ring.push(edges[i].ends.0);
-            i = *from.get(&edges[i].keys.1)?;
-        }
-        if !ring.is_empty() {
-            if i != start {
-                return None;
-            }
-            ring.reverse();
-            rings.push(ring);
-        }
-    }
-    Some(rings)
+    let keys: Vec<(u32, u32)> = edges.iter().map(|e| e.keys).collect();
+    let loops = edge_loops(&keys)?;
+    Some(loops.into_iter().map(|l| l.into_iter().rev().map(|e| edges[e].ends.0).collect()).collect())
 }
 
 /// Joins the polygons that share an edge, marks `bad` those with an edge shared other than
