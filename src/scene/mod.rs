@@ -7,9 +7,9 @@ mod obj;
 mod solids;
 pub use build::SceneBuilder;
 pub(crate) use obj::ObjText;
-pub(crate) use solids::Solid;
 #[cfg(test)]
 pub(crate) use solids::NO_SOLID;
+pub(crate) use solids::{Closure, Solid};
 mod write;
 
 /// No polygon (in [`Scene::across`]).
@@ -779,25 +779,26 @@ impl Scene {
         &self.vertices[p.start as usize..(p.start + p.len) as usize]
     }
 
-    /// `closed[s]`: whether solid `s` is closed as seen from `from` (a light sample or the
-    /// eye): `from` lies outside its bounds (a directional light always does), and each of
-    /// its holes, projected from `from`, is a simple polygon wound as a polygon turned away
-    /// from `from` is, so a cap over it could turn its back to `from` too (see `solids`).
-    /// [`Scene::turned_away_on_solid`] needs it.
-    pub(crate) fn closed_from(&self, from: LightSample) -> Vec<bool> {
+    /// `closed[s]`: how solid `s` looks from `from` (a light sample or the eye): open, or
+    /// closed but for some windows (holes a cap turned away from `from` could not close;
+    /// see `solids`). [`Scene::turned_away_on_solid`] needs it.
+    pub(crate) fn closed_from(&self, from: LightSample) -> Vec<solids::Closure> {
         self.solids.iter().zip(&self.solid_holes).map(|(s, holes)| solids::closed_from(s, holes, from)).collect()
     }
 
     /// Whether polygon `i` belongs to a solid closed as seen from `from` (`closed`, from
-    /// [`Scene::closed_from`]) and turns its back to `from`. Seen from `from`, such a polygon
-    /// is covered everywhere by a polygon of the same solid that faces `from`, nearer along
-    /// every ray (where the two meet, at their shared edge, at the same distance): it never
-    /// casts a shadow, and is never the nearest polygon seen. Ours, not the papers'; see
+    /// [`Scene::closed_from`]), turns its back to `from`, and cannot be seen through one of
+    /// the solid's windows. Seen from `from`, such a polygon is covered everywhere by a
+    /// polygon of the same solid that faces `from`, nearer along every ray (where the two
+    /// meet, at their shared edge, at the same distance): it never casts a shadow, and is
+    /// never the nearest polygon seen. Ours, not the papers'; see
     /// `docs/algorithms/bouknight-kelley.md`, "Speed-ups that are ours", and
     /// `docs/algorithms/scanline.md`.
-    pub(crate) fn turned_away_on_solid(&self, i: usize, from: LightSample, closed: &[bool]) -> bool {
+    pub(crate) fn turned_away_on_solid(&self, i: usize, from: LightSample, closed: &[solids::Closure]) -> bool {
         let s = self.solid_of[i] as usize;
-        closed.get(s) == Some(&true) && from.side_of(&self.polygons[i].plane) * self.solids[s].sign < 0.0
+        let Some(solids::Closure::Closed(windows)) = closed.get(s) else { return false };
+        from.side_of(&self.polygons[i].plane) * self.solids[s].sign < 0.0
+            && !windows.iter().any(|w| w.may_show(self.verts(i)))
     }
 
     /// Whether polygon `i` is one piece of a non-planar face split into a fan (its face has

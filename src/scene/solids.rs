@@ -19,7 +19,9 @@
 //! the hole's loop, projected from the viewpoint, is a simple polygon wound the way a
 //! polygon turned away is (a triangulation of that polygon, lifted onto the loop's
 //! corners, is the cap); [`crate::scene::Scene::closed_from`] checks it per viewpoint, and
-//! assumes, as above, that the capped surface does not pass through itself.
+//! assumes, as above, that the capped surface does not pass through itself. A hole no such
+//! cap closes is a *window*: closed by the fan from its centre, which the viewpoint sees
+//! within the box of the hole's corners, it hides only the polygons seen there.
 
 use super::LightSample;
 use crate::geometry::weiler_atherton::signed_area;
@@ -46,41 +48,97 @@ impl Solid {
     }
 }
 
-/// Whether `solid`, with holes `holes`, is closed as seen from `from`: `from` lies outside
-/// its bounds (a directional light always does), and each hole, projected from `from`, is
-/// a simple polygon wound as a polygon turned away from `from` is (see the module's notes).
-pub(crate) fn closed_from(solid: &Solid, holes: &[Vec<DVec3>], from: LightSample) -> bool {
+/// How a solid looks from one viewpoint ([`closed_from`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) enum Closure {
+    /// Its polygons turned away may be seen.
+    #[default]
+    Open,
+    /// Closed but for these windows: a polygon turned away from the viewpoint is hidden by
+    /// the solid's own polygons unless, seen from the viewpoint, it may lie behind one.
+    Closed(Vec<Window>),
+}
+
+/// A hole that no cap turned away from the viewpoint can close. The cap taken for it is the
+/// fan from its centre, which, seen from the viewpoint, lies within the box of its
+/// corners.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Window {
+    frame: Frame,
+    lo: DVec2,
+    hi: DVec2,
+}
+
+impl Window {
+    /// Whether a polygon with corners `verts` may, seen from the viewpoint, lie behind the
+    /// window (its box meets the window's, or a corner is not in front of the viewpoint).
+    pub fn may_show(&self, verts: &[DVec3]) -> bool {
+        let Some(seen) = verts.iter().map(|&v| self.frame.see(v)).collect::<Option<Vec<DVec2>>>() else { return true };
+        let Some((lo, hi)) = crate::geometry::weiler_atherton::ring_bounds(&seen) else { return true };
+        lo.cmple(self.hi).all() && self.lo.cmple(hi).all()
+    }
+}
+
+/// How a solid with holes `holes` looks from `from`: open when `from` lies inside its
+/// bounds (a directional light never does); otherwise closed, but for the holes that,
+/// projected from `from`, are not simple polygons wound as a polygon turned away from
+/// `from` is (those a cap turned away could close; see the module's notes).
+pub(crate) fn closed_from(solid: &Solid, holes: &[Vec<DVec3>], from: LightSample) -> Closure {
     let outside = match from {
         LightSample::Point(p) => solid.outside(p),
         LightSample::Directional(_) => true,
     };
-    outside
-        && holes
-            .iter()
-            .all(|ring| seen_from(from, ring).is_some_and(|r| signed_area(&r) * solid.sign > 0.0 && simple(&r)))
+    if !outside {
+        return Closure::Open;
+    }
+    let mut windows = Vec::new();
+    for ring in holes {
+        let Some(frame) = Frame::toward(from, ring) else { return Closure::Open };
+        let Some(seen) = ring.iter().map(|&v| frame.see(v)).collect::<Option<Vec<DVec2>>>() else {
+            return Closure::Open;
+        };
+        if signed_area(&seen) * solid.sign > 0.0 && simple(&seen) {
+            continue;
+        }
+        let Some((lo, hi)) = crate::geometry::weiler_atherton::ring_bounds(&seen) else { return Closure::Open };
+        windows.push(Window { frame, lo, hi });
+    }
+    Closure::Closed(windows)
 }
 
-/// `ring` projected from `from` onto a plane across the line of sight to its centre, on
-/// axes `e1`, `e2` with `e1 × e2` pointing away from `from`: a polygon turned away from
-/// `from` comes out counter-clockwise. `None` when a corner is not in front of `from`.
-fn seen_from(from: LightSample, ring: &[DVec3]) -> Option<Vec<DVec2>> {
-    let centre = ring.iter().copied().sum::<DVec3>() / ring.len() as f64;
-    let axis = unit(match from {
-        LightSample::Point(p) => centre - p,
-        LightSample::Directional(d) => d,
-    })?;
-    let e1 = axis.any_orthonormal_vector();
-    let e2 = axis.cross(e1);
-    ring.iter()
-        .map(|&v| match from {
+/// A view from `from` across the line of sight to a hole's centre, on axes `e1`, `e2` with
+/// `e1 × e2 = axis` pointing away from `from`: a polygon turned away from `from` comes out
+/// counter-clockwise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Frame {
+    from: LightSample,
+    axis: DVec3,
+    e1: DVec3,
+    e2: DVec3,
+}
+
+impl Frame {
+    fn toward(from: LightSample, ring: &[DVec3]) -> Option<Frame> {
+        let centre = ring.iter().copied().sum::<DVec3>() / ring.len() as f64;
+        let axis = unit(match from {
+            LightSample::Point(p) => centre - p,
+            LightSample::Directional(d) => d,
+        })?;
+        let e1 = axis.any_orthonormal_vector();
+        Some(Frame { from, axis, e1, e2: axis.cross(e1) })
+    }
+
+    /// Where `v` is seen, or `None` when it is not in front of the viewpoint.
+    fn see(&self, v: DVec3) -> Option<DVec2> {
+        match self.from {
             LightSample::Point(p) => {
                 let q = v - p;
-                let depth = q.dot(axis);
-                (depth > 0.0).then(|| DVec2::new(q.dot(e1), q.dot(e2)) / depth)
+                let depth = q.dot(self.axis);
+                (depth > 0.0).then(|| DVec2::new(q.dot(self.e1), q.dot(self.e2)) / depth)
             }
-            LightSample::Directional(_) => Some(DVec2::new(v.dot(e1), v.dot(e2))),
-        })
-        .collect()
+            LightSample::Directional(_) => Some(DVec2::new(v.dot(self.e1), v.dot(self.e2))),
+        }
+    }
 }
 
 /// One polygon's corners: `keys[start..start+len]` (welded vertex ids) and the same range of
@@ -344,32 +402,63 @@ mod tests {
         assert!(s.solids.is_empty() && s.solid_of.iter().all(|&i| i == NO_SOLID));
     }
 
-    /// A cube missing its face at x = 1 is a solid with one hole, closed as seen from the
-    /// side away from the hole (a cap there would turn its back) and not from the hole's
-    /// side, nor from inside its bounds; its polygons turned away are left out only where it
-    /// is closed.
+    /// A cube missing its face at x = 1 is a solid with one hole. Seen from the side away
+    /// from the hole it is closed (a cap there would turn its back); seen from the hole's
+    /// side the hole is a window, through which the inside faces turned away are seen, so
+    /// they stay; from inside its bounds it is open.
     #[test]
-    fn a_solid_with_a_hole_is_closed_only_from_where_a_cap_would_turn_away() {
-        use crate::scene::LightSample;
+    fn a_solid_with_a_hole_is_closed_but_for_the_windows_it_shows() {
+        use crate::scene::{Closure, LightSample};
         let mut open = cube(false, DVec3::ZERO);
         open.pop();
         let s = scene(&[open]);
         assert_eq!(s.solids.len(), 1);
         assert_eq!(s.solid_holes[0].len(), 1);
         assert_eq!(s.solid_holes[0][0].len(), 4);
-        let from = |p: DVec3| s.closed_from(LightSample::Point(p))[0];
-        assert!(from(DVec3::new(-5.0, 0.3, 0.4)));
-        assert!(!from(DVec3::new(5.0, 0.3, 0.4)));
-        assert!(!from(DVec3::new(0.5, 0.5, 0.5)));
-        assert!(s.closed_from(LightSample::Directional(DVec3::X))[0]);
-        assert!(!s.closed_from(LightSample::Directional(DVec3::NEG_X))[0]);
-        // Seen from x = -5, the face at x = 0 faces the viewpoint and the one at z = 1 (the
-        // second) turns away from a viewpoint at z = -3.
+        let windows = |from: LightSample| match &s.closed_from(from)[0] {
+            Closure::Closed(w) => Some(w.len()),
+            Closure::Open => None,
+        };
+        assert_eq!(windows(LightSample::Point(DVec3::new(-5.0, 0.3, 0.4))), Some(0));
+        assert_eq!(windows(LightSample::Point(DVec3::new(5.0, 0.3, 0.4))), Some(1));
+        assert_eq!(windows(LightSample::Point(DVec3::new(0.5, 0.5, 0.5))), None);
+        assert_eq!(windows(LightSample::Directional(DVec3::X)), Some(0));
+        assert_eq!(windows(LightSample::Directional(DVec3::NEG_X)), Some(1));
+        // From x = -5 the face at x = 0 (the fifth) faces the viewpoint, and the one at
+        // z = 1 (the second) turns away from a viewpoint at z = -3: it is left out.
         let p = LightSample::Point(DVec3::new(-5.0, 0.3, -3.0));
         let closed = s.closed_from(p);
         assert!(!s.turned_away_on_solid(4, p, &closed) && s.turned_away_on_solid(1, p, &closed));
-        let q = LightSample::Point(DVec3::new(5.0, 0.3, -3.0));
-        assert!(!s.turned_away_on_solid(1, q, &s.closed_from(q)));
+        // From x = 5 every face but the missing one is seen from inside, through the hole.
+        let q = LightSample::Point(DVec3::new(5.0, 0.3, 0.4));
+        let closed = s.closed_from(q);
+        assert!((0..5).all(|i| !s.turned_away_on_solid(i, q, &closed)));
+    }
+
+    /// A long box open at its end x = 10, seen from beyond that end and above: through the
+    /// hole the viewpoint sees the inside of the far end (x = 0) only near the hole's line of
+    /// sight, so the far end's face, turned away and seen well off the window, is left out,
+    /// while the faces along the box, which reach the window, stay.
+    #[test]
+    fn a_window_keeps_only_what_may_be_seen_through_it() {
+        use crate::scene::LightSample;
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let tube = vec![
+            vec![c(0., 0., 0.), c(0., 1., 0.), c(10., 1., 0.), c(10., 0., 0.)],
+            vec![c(0., 0., 1.), c(10., 0., 1.), c(10., 1., 1.), c(0., 1., 1.)],
+            vec![c(0., 0., 0.), c(10., 0., 0.), c(10., 0., 1.), c(0., 0., 1.)],
+            vec![c(0., 1., 0.), c(0., 1., 1.), c(10., 1., 1.), c(10., 1., 0.)],
+            vec![c(0., 0., 0.), c(0., 0., 1.), c(0., 1., 1.), c(0., 1., 0.)],
+        ];
+        let s = scene(&[tube]);
+        assert_eq!(s.solids.len(), 1);
+        // From high above, just beyond the open end: the closed end at x = 0 faces out along
+        // -x, away from the viewpoint at x = 11.
+        let p = LightSample::Point(DVec3::new(11.0, 30.0, 0.5));
+        let closed = s.closed_from(p);
+        assert!(matches!(&closed[0], crate::scene::Closure::Closed(w) if w.len() == 1));
+        assert!(s.turned_away_on_solid(4, p, &closed), "the far end lies well off the window");
+        assert!(!s.turned_away_on_solid(2, p, &closed), "the floor of the box reaches the window");
     }
 
     /// Edges used once that pass a corner twice (a figure eight) make no hole to cap; a
