@@ -313,6 +313,52 @@ fn random_solids_with_lights_inside_on_and_around() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Random meshes closed but for one or two holes (a box, prism or sphere with faces left
+/// out), lit from all round, so that some lights see into a hole (a window) and some do
+/// not, seen by an eye from all round too: every exact stage, which leave out the polygons
+/// turned away that no window shows, equals ray-cast at every pixel but ties, and the
+/// cull does leave polygons out.
+#[test]
+fn random_solids_with_holes_lit_and_seen_from_all_round() {
+    use rand::{Rng, SeedableRng};
+    let (mut in_shadow, mut dropped) = (0, 0);
+    for seed in 0..60u64 {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1000 + seed);
+        let mut solid = solid(seed % 3, &mut rng);
+        let holes = 1 + (seed % 2) as usize;
+        for _ in 0..holes {
+            let k = rng.gen_range(0..solid.faces.len());
+            solid.faces.remove(k);
+        }
+        let c = solid.centre;
+        let round = |rng: &mut rand_chacha::ChaCha8Rng, r: f64| {
+            let (a, y) = (rng.gen_range(0.0..std::f64::consts::TAU), rng.gen_range(-0.3f64..1.0));
+            let h = (1.0 - y * y).sqrt();
+            [c[0] + r * h * a.cos(), c[1] + r * y, c[2] + r * h * a.sin()]
+        };
+        let (light, eye) = (round(&mut rng, 3.0), round(&mut rng, 4.0));
+        let src = format!(
+            "[camera]\neye = {}\ntarget = {}\nwidth = 64\nheight = 48\nnear = 0.01\n\
+             [[light]]\nkind = \"point\"\nposition = {}\n\
+             [[object]]\npolygons = [[[-5.0,0.0,-5.0],[-5.0,0.0,5.0],[5.0,0.0,5.0],[5.0,0.0,-5.0]]]\n\
+             [[object]]\npolygons = [{}]\n",
+            v3(eye),
+            v3(c),
+            v3(light),
+            solid.faces.iter().map(|f| poly(f)).collect::<Vec<_>>().join(", ")
+        );
+        let scene = Scene::from_toml(&src, std::path::Path::new("holes.toml"), std::path::Path::new("."))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let (_, s) = check(&scene, &format!("solid with holes, seed {seed}"));
+        in_shadow += s;
+        let opts =
+            umbra::RenderOptions { shadows: ShadowMethod::BouknightKelley(Default::default()), ..Default::default() };
+        dropped += umbra::render(&scene, &opts).unwrap().stats.shadow_counters.get("casters_dropped_facing_away");
+    }
+    assert!(in_shadow > 60 * 100, "only {in_shadow} pixels in shadow");
+    assert!(dropped > 0, "no polygon turned away was left out");
+}
+
 struct Solid {
     faces: Vec<Vec<[f64; 3]>>,
     centre: [f64; 3],
