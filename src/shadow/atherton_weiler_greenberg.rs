@@ -299,11 +299,21 @@ fn cut_all(
     front: &Piece,
     stats: &mut Pass1,
 ) -> std::result::Result<Vec<(u32, Piece, Option<Parts>)>, ClipError> {
+    // Without splits, the sort hands over every piece whose box meets the front polygon's:
+    // those apart from it are found here (in parallel, where the cuts are).
+    let cut_unless_apart = |p: &Piece, st: &mut Pass1| {
+        let apart = !st.convex_split && regions_apart(&p.region, &front.region);
+        if apart {
+            Ok(None)
+        } else {
+            cut(p, front, st)
+        }
+    };
     if taken.len() < PARALLEL_CUTS || stats.convex_split {
         return taken
             .into_iter()
             .map(|(q, p)| {
-                let parts = cut(&p, front, stats)?;
+                let parts = cut_unless_apart(&p, stats)?;
                 Ok((q, p, parts))
             })
             .collect();
@@ -313,7 +323,7 @@ fn cut_all(
         .into_par_iter()
         .map(|(q, p)| {
             let mut st = Pass1 { ..flags };
-            let parts = cut(&p, front, &mut st)?;
+            let parts = cut_unless_apart(&p, &mut st)?;
             Ok((q, p, parts, st))
         })
         .collect::<std::result::Result<_, ClipError>>()?;
@@ -407,8 +417,11 @@ impl Sorting {
                 let Some(p) = &arena[q as usize] else { return false };
                 if stamp[q as usize] != fi {
                     stamp[q as usize] = fi;
-                    // Convex pairs are tested as they are split.
-                    if p.overlaps(front) && (splits(p, front, stats) || !regions_apart(&p.region, &front.region)) {
+                    // Convex pairs are tested as they are split; without splits, pairs are
+                    // tested as they are cut ([`cut_all`]).
+                    if p.overlaps(front)
+                        && (splits(p, front, stats) || !stats.convex_split || !regions_apart(&p.region, &front.region))
+                    {
                         found.push(q);
                     }
                 }
