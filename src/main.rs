@@ -74,15 +74,10 @@ enum Command {
 }
 
 /// Options of the shadow stages, shared by every command that renders.
+/// Atherton-Weiler-Greenberg's switches, each putting the paper's way back (for `render`,
+/// `bench` and the like, and for `export-shadows`).
 #[derive(clap::Args)]
-struct ShadowArgs {
-    /// Bouknight-Kelley: project every pair, without the sphere prefilter (to measure it).
-    #[arg(long)]
-    no_prefilter: bool,
-    /// Bouknight-Kelley: keep the polygons of closed solids that face away from the light
-    /// as casters, as the paper does (to measure what dropping them saves).
-    #[arg(long)]
-    no_solid_cull: bool,
+struct AwgFlags {
     /// Atherton-Weiler-Greenberg: clip every pair of pieces in the light view with Weiler
     /// and Atherton's clipper, as the paper does, instead of splitting convex pieces by each
     /// other's edges (to measure what splitting saves).
@@ -98,6 +93,30 @@ struct ShadowArgs {
     /// lighting them whole.
     #[arg(long)]
     no_lone_sheets: bool,
+}
+
+impl AwgFlags {
+    /// Atherton-Weiler-Greenberg's settings from these flags.
+    fn options(&self) -> AthertonWeilerGreenbergOptions {
+        AthertonWeilerGreenbergOptions {
+            convex_split: !self.no_convex_split,
+            backgrounds: !self.no_backgrounds,
+            lone_sheets: !self.no_lone_sheets,
+        }
+    }
+}
+
+#[derive(clap::Args)]
+struct ShadowArgs {
+    /// Bouknight-Kelley: project every pair, without the sphere prefilter (to measure it).
+    #[arg(long)]
+    no_prefilter: bool,
+    /// Bouknight-Kelley: keep the polygons of closed solids that face away from the light
+    /// as casters, as the paper does (to measure what dropping them saves).
+    #[arg(long)]
+    no_solid_cull: bool,
+    #[command(flatten)]
+    awg: AwgFlags,
     /// Crow and stencil-volume: count shadow volumes from the eye with the eye's own count
     /// (zpass), from infinity (zfail), or from zero at the eye (naive-zpass, wrong when the
     /// eye is in shadow).
@@ -184,7 +203,7 @@ impl ShadowArgs {
                 prefilter: !self.no_prefilter,
                 solid_cull: !self.no_solid_cull,
             }),
-            ShadowMethod::AthertonWeilerGreenberg(_) => ShadowMethod::AthertonWeilerGreenberg(self.awg()),
+            ShadowMethod::AthertonWeilerGreenberg(_) => ShadowMethod::AthertonWeilerGreenberg(self.awg.options()),
             ShadowMethod::Crow(_) => ShadowMethod::Crow(volumes),
             ShadowMethod::StencilVolume(_) => ShadowMethod::StencilVolume(volumes),
             ShadowMethod::Williams(_) => ShadowMethod::Williams(WilliamsOptions {
@@ -198,15 +217,6 @@ impl ShadowArgs {
                 fit_to_view: !self.no_fit,
             }),
             other => other,
-        }
-    }
-
-    /// Atherton-Weiler-Greenberg's settings from these flags.
-    fn awg(&self) -> AthertonWeilerGreenbergOptions {
-        AthertonWeilerGreenbergOptions {
-            convex_split: !self.no_convex_split,
-            backgrounds: !self.no_backgrounds,
-            lone_sheets: !self.no_lone_sheets,
         }
     }
 
@@ -507,20 +517,8 @@ struct ExportArgs {
     /// Overwrite the OBJ file if it exists.
     #[arg(long)]
     force: bool,
-    /// Clip every pair of pieces in the light view with Weiler and Atherton's clipper, as
-    /// the paper does, instead of splitting convex pieces by each other's edges.
-    #[arg(long)]
-    no_convex_split: bool,
-    /// Atherton-Weiler-Greenberg: sort the polygons that lie behind everything they overlap
-    /// in the light view (a floor) with the rest, as the paper does, instead of lighting them
-    /// with the visible pieces over them cut out as holes.
-    #[arg(long)]
-    no_backgrounds: bool,
-    /// Atherton-Weiler-Greenberg: sort the polygons that nothing else in the light view
-    /// meets with the rest, as the paper does, instead of finding them sheet by sheet and
-    /// lighting them whole.
-    #[arg(long)]
-    no_lone_sheets: bool,
+    #[command(flatten)]
+    awg: AwgFlags,
 }
 
 fn parse<T: std::str::FromStr<Err = Error>>(s: &str) -> Result<T, String> {
@@ -731,12 +729,7 @@ fn export_shadows_command(e: ExportArgs) -> umbra::Result<()> {
     }
     refuse_overwrite(std::slice::from_ref(&e.output), e.force)?;
     let mut counters = umbra::Counters::default();
-    let options = AthertonWeilerGreenbergOptions {
-        convex_split: !e.no_convex_split,
-        backgrounds: !e.no_backgrounds,
-        lone_sheets: !e.no_lone_sheets,
-    };
-    let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, options, &mut counters)?;
+    let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, e.awg.options(), &mut counters)?;
     db.write_obj(&scene, &e.output)?;
     let polygons: usize = db.samples.iter().map(Vec::len).sum();
     say(&format!("wrote {}: {polygons} lit detail polygon(s) of light {}", e.output.display(), e.light))

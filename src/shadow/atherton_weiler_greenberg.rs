@@ -1214,14 +1214,22 @@ impl<'a> AthertonWeilerGreenberg<'a> {
                 // Through the camera in parallel, into the overlay in order.
                 // A detail polygon that is its whole source polygon (ours) covers every run
                 // on it: it needs no edges (but is drawn with them for `--debug`).
-                let whole = |d: &DetailPolygon| {
-                    !ctx.keep_outlines && matches!(&d.rings[..], [r] if r[..] == *ctx.scene.verts(d.source as usize))
-                };
+                let whole: Vec<bool> = polys
+                    .par_iter()
+                    .map(|d| {
+                        !ctx.keep_outlines
+                            && matches!(&d.rings[..], [r] if r[..] == *ctx.scene.verts(d.source as usize))
+                    })
+                    .collect();
+                let seen =
+                    |(d, &whole): &(&DetailPolygon, &bool), want: bool| whole == want && ctx.visible[d.source as usize];
                 let wholes: Vec<u32> =
-                    polys.par_iter().filter(|d| ctx.visible[d.source as usize] && whole(d)).map(|d| d.source).collect();
+                    polys.par_iter().zip(&whole).filter(|p| seen(p, true)).map(|(d, _)| d.source).collect();
                 let screen: Vec<(u32, Vec<Vec<DVec2>>)> = polys
                     .par_iter()
-                    .filter(|d| ctx.visible[d.source as usize] && !whole(d))
+                    .zip(&whole)
+                    .filter(|p| seen(p, false))
+                    .map(|(d, _)| d)
                     .map_init(
                         || ([Vec::new(), Vec::new()], Vec::new()),
                         |(scratch, ring), d| {
