@@ -76,6 +76,40 @@ impl<T> Kept<Vec<T>> {
     }
 }
 
+/// A buffer taken from a [`Pool`] and given back when dropped: scratch for one piece of a
+/// parallel loop (rayon's `map_init`), so that the many pieces a loop is split into share
+/// the few buffers that are in use at once.
+pub(crate) struct Lease<'a, T> {
+    buffer: Vec<T>,
+    pool: &'a Pool<T>,
+}
+
+impl<T> Pool<T> {
+    /// A kept buffer (or a new, empty one), given back when the lease is dropped.
+    pub(crate) fn lease(&self) -> Lease<'_, T> {
+        Lease { buffer: self.take(), pool: self }
+    }
+}
+
+impl<T> std::ops::Deref for Lease<'_, T> {
+    type Target = Vec<T>;
+    fn deref(&self) -> &Vec<T> {
+        &self.buffer
+    }
+}
+
+impl<T> std::ops::DerefMut for Lease<'_, T> {
+    fn deref_mut(&mut self) -> &mut Vec<T> {
+        &mut self.buffer
+    }
+}
+
+impl<T> Drop for Lease<'_, T> {
+    fn drop(&mut self) {
+        self.pool.give(std::mem::take(&mut self.buffer));
+    }
+}
+
 /// Whole frames kept for reuse (what each mirror shows).
 pub(crate) type Frames = Kept<crate::frame::Frame>;
 
@@ -191,6 +225,18 @@ impl Pools {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_leased_buffer_comes_back_when_dropped() {
+        let pool = Pool::<u32>::default();
+        {
+            let mut lease = pool.lease();
+            lease.resize(100, 7);
+        }
+        let again = pool.lease();
+        assert_eq!(again.len(), 100);
+        assert!(pool.take().is_empty(), "the lease holds the only buffer");
+    }
 
     #[test]
     fn a_buffer_given_back_is_taken_again_with_its_memory() {

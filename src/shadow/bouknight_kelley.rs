@@ -35,12 +35,13 @@
 //! polygons on the far side of the light from B are clipped away by the plane through the
 //! light; zero-area projections are dropped. None of these divide by zero.
 
-use super::overlay::{Interval, Overlay, OverlayWalker};
+use super::overlay::{Interval, Overlay, OverlayWalker, ReceiverTable};
 use super::projection::{bounding_rectangle, edge_on, faces_away_on_solid, light_side, Projector, Target};
 use super::{
     BouknightKelleyOptions, Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker,
 };
 use crate::geometry::grid_cells;
+use crate::pool::Pool;
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -114,22 +115,31 @@ fn shadow_polygons(
     let grid = options.prefilter.then(|| SphereGrid::new(scene, sample, &casters, &receivers));
     counters.add("prefilter_grid_us", t.elapsed().as_micros() as u64);
 
-    let per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>, Pairs)> = receivers
+    // Receivers differ widely in cost, so the loop is cut into pieces of at most
+    // `RECEIVERS_PER_PIECE` (rayon's own cut leaves a few long pieces, and a thread that
+    // runs out of work waits for the last); the pieces share their threads' stamps.
+    let stamps = Pool::default();
+    let per_receiver: Vec<(Tally, ReceiverTable, Pairs)> = receivers
         .par_iter()
+        .with_max_len(RECEIVERS_PER_PIECE)
         .map_init(
-            || (Projector::default(), vec![u32::MAX; n], [Vec::new(), Vec::new()], Vec::new()),
-            |(proj, stamp, scratch, ring), &b| {
+            || (Projector::default(), stamps.lease(), [Vec::new(), Vec::new()], Vec::new(), Vec::new()),
+            |(proj, stamp, scratch, ring, candidates), &b| {
+                if stamp.len() != n {
+                    stamp.clear();
+                    stamp.resize(n, u32::MAX);
+                }
                 let t = Instant::now();
-                let candidates: Vec<u32> = match &grid {
-                    Some(g) => g.candidates(b, stamp),
-                    None => casters.clone(),
-                };
+                match &grid {
+                    Some(g) => g.candidates(b, stamp, candidates),
+                    None => candidates.clone_from(&casters),
+                }
                 let prefilter_ns = t.elapsed().as_nanos() as u64;
                 let t = Instant::now();
-                let (mut tally, rings, pairs) = project_onto(ctx, sample, b, candidates, proj, scratch, ring);
+                let (mut tally, table, pairs) = project_onto(ctx, sample, b, candidates, proj, scratch, ring);
                 tally.prefilter_ns += prefilter_ns;
                 tally.projection_ns += t.elapsed().as_nanos() as u64;
-                (b, tally, rings, pairs)
+                (tally, table, pairs)
             },
         )
         .collect();
@@ -149,27 +159,27 @@ fn shadow_polygons(
 
 /// Steps 2 and 3 for receiver `b`: each candidate caster (not a piece of `b`'s own face) is
 /// dropped when wholly behind `b` as the light sees it, else projected from the light onto
-/// `b`'s plane and into the image. Returns the tally, the shadow polygons' screen rings, and
+/// `b`'s plane and into the image. Returns the tally, the shadow polygons' edge table, and
 /// (for traces) what became of each pair.
 fn project_onto(
     ctx: &ShadowContext,
     sample: LightSample,
     b: u32,
-    candidates: Vec<u32>,
+    candidates: &[u32],
     proj: &mut Projector,
     scratch: &mut [Vec<DVec3>; 2],
     ring: &mut Vec<DVec2>,
-) -> (Tally, Vec<Vec<DVec2>>, Pairs) {
+) -> (Tally, ReceiverTable, Pairs) {
     let (scene, record) = (ctx.scene, ctx.keep_outlines);
     let mut tally = Tally::default();
-    let mut rings = Vec::new();
+    let mut table = ReceiverTable::new(b, ctx.view.height, record);
     let mut pairs = Pairs::default();
     let plane = scene.polygons[b as usize].plane;
     let side = light_side(&plane, sample);
     let b_verts = scene.verts(b as usize);
     let target = Target::new(plane, bounding_rectangle(b_verts, &plane), sample);
     let wedge = Wedge::of(b_verts, sample, ctx.extent);
-    for a in candidates {
+    for &a in candidates {
         if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
             continue;
         }
@@ -188,37 +198,41 @@ fn project_onto(
         } else if !proj.project(a_verts, &target) {
             tally.empty += 1;
         } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
-            rings.push(ring.clone());
+            table.add(ring);
             if record {
                 pairs.shadow_polygons.push((0, a));
             }
         }
     }
-    (tally, rings, pairs)
+    table.finish();
+    (tally, table, pairs)
 }
+
+/// The most receivers one piece of the parallel loop over them takes.
+const RECEIVERS_PER_PIECE: usize = 512;
 
 /// Every receiver's shadow polygons into one overlay, tagged with their receiver, and the
 /// tallies summed.
 fn merge(
     ctx: &ShadowContext,
-    per_receiver: Vec<(u32, Tally, Vec<Vec<DVec2>>, Pairs)>,
+    per_receiver: Vec<(Tally, ReceiverTable, Pairs)>,
 ) -> (Overlay, Tally, FxHashMap<u32, Pairs>) {
     let mut total = Tally::default();
     let mut kept_pairs = FxHashMap::default();
-    let mut receivers = Vec::with_capacity(per_receiver.len());
+    let mut tables = Vec::with_capacity(per_receiver.len());
     let mut tag = 0;
-    for (b, tally, rings, mut pairs) in per_receiver {
+    for (tally, table, mut pairs) in per_receiver {
         total.add(&tally);
-        for (i, p) in pairs.shadow_polygons.iter_mut().enumerate() {
-            p.0 = tag + i as u32;
-        }
-        tag += rings.len() as u32;
         if ctx.keep_outlines {
-            kept_pairs.insert(b, pairs);
+            for (i, p) in pairs.shadow_polygons.iter_mut().enumerate() {
+                p.0 = tag + i as u32;
+            }
+            tag += table.len() as u32;
+            kept_pairs.insert(table.receiver(), pairs);
         }
-        receivers.push((b, rings));
+        tables.push(table);
     }
-    let overlay = Overlay::from_receivers(ctx.view.height, ctx.keep_outlines, &receivers, std::slice::from_ref);
+    let overlay = Overlay::from_tables(ctx.view.height, ctx.keep_outlines, tables);
     (overlay, total, kept_pairs)
 }
 
@@ -389,8 +403,8 @@ impl SphereGrid {
     /// whose bounding cones overlap (for a point light; shared cells suffice for a
     /// directional light, whose boxes are the cells' own test). `stamp` is scratch, one entry
     /// per polygon, that keeps each caster from being listed twice.
-    fn candidates(&self, b: u32, stamp: &mut [u32]) -> Vec<u32> {
-        let mut out = Vec::new();
+    fn candidates(&self, b: u32, stamp: &mut [u32], out: &mut Vec<u32>) {
+        out.clear();
         let (bc, bh) = self.extents[b as usize].cone;
         for (c, r) in self.cells_of(b) {
             for &a in self.cell(c, r) {
@@ -412,7 +426,6 @@ impl SphereGrid {
                 }
             }
         }
-        out
     }
 }
 
@@ -632,9 +645,9 @@ mod tests {
             let casters: Vec<u32> = (0..n as u32).collect();
             let grid = SphereGrid::new(&scene, LightSample::Point(light), &casters, &casters);
             let mut stamp = vec![u32::MAX; n];
-            let mut found = 0;
+            let (mut found, mut kept) = (0, Vec::new());
             for b in 0..n as u32 {
-                let kept = grid.candidates(b, &mut stamp);
+                grid.candidates(b, &mut stamp, &mut kept);
                 let t = scene.verts(b as usize);
                 for _ in 0..200 {
                     let (u, v) = (rng.gen_range(0.0..1.0f64), rng.gen_range(0.0..1.0f64));

@@ -21,6 +21,8 @@ pub struct Overlay {
     height: u32,
     /// One edge table per receiver, in the order receivers first appeared.
     tables: Vec<EdgeTable>,
+    /// The tag of each table's first polygon: its edges are tagged from 0.
+    base: Vec<u32>,
     slot: FxHashMap<u32, Slot>,
     count: usize,
     rings: Vec<Vec<DVec2>>,
@@ -47,6 +49,61 @@ pub struct Interval {
     pub tag: u32,
 }
 
+/// One receiver's overlay polygons, gathered on their own (in parallel with other
+/// receivers') before they join an [`Overlay`] with [`Overlay::from_tables`].
+#[derive(Debug)]
+pub struct ReceiverTable {
+    receiver: u32,
+    table: EdgeTable,
+    count: u32,
+    rings: Vec<Vec<DVec2>>,
+    keep_rings: bool,
+}
+
+impl ReceiverTable {
+    /// No polygons yet on scene polygon `receiver`, in an image `height` lines high;
+    /// `keep_rings` keeps their outlines.
+    pub fn new(receiver: u32, height: u32, keep_rings: bool) -> Self {
+        ReceiverTable { receiver, table: EdgeTable::new(height), count: 0, rings: Vec::new(), keep_rings }
+    }
+
+    /// Adds a polygon with several rings (holes by the even-odd rule).
+    pub fn add_rings(&mut self, rings: &[Vec<DVec2>]) {
+        for ring in rings {
+            self.add_ring_of(ring);
+        }
+        self.count += 1;
+    }
+
+    /// Adds a polygon with one ring.
+    pub fn add(&mut self, ring: &[DVec2]) {
+        self.add_ring_of(ring);
+        self.count += 1;
+    }
+
+    fn add_ring_of(&mut self, ring: &[DVec2]) {
+        self.table.add_ring(self.count, ring);
+        if self.keep_rings {
+            self.rings.push(ring.to_vec());
+        }
+    }
+
+    /// The receiver.
+    pub fn receiver(&self) -> u32 {
+        self.receiver
+    }
+
+    /// Number of polygons.
+    pub fn len(&self) -> usize {
+        self.count as usize
+    }
+
+    /// Sorts the edge table; call once after the last polygon.
+    pub fn finish(&mut self) {
+        self.table.finish();
+    }
+}
+
 impl Overlay {
     /// An empty overlay for an image `height` lines high; `keep_rings` keeps each polygon's
     /// outline for drawing (`--debug`).
@@ -67,9 +124,10 @@ impl Overlay {
         let slot = slot as usize;
         if slot == self.tables.len() {
             self.tables.push(EdgeTable::new(self.height));
+            self.base.push(tag);
         }
         for ring in rings {
-            self.tables[slot].add_ring(tag, ring);
+            self.tables[slot].add_ring(tag - self.base[slot], ring);
             if self.keep_rings {
                 self.rings.push(ring.clone());
             }
@@ -87,34 +145,32 @@ impl Overlay {
         receivers: &[(u32, Vec<P>)],
         rings_of: impl Fn(&P) -> &[Vec<DVec2>] + Sync,
     ) -> Self {
-        let receivers: Vec<&(u32, Vec<P>)> = receivers.iter().filter(|r| !r.1.is_empty()).collect();
-        let mut first = Vec::with_capacity(receivers.len());
-        let mut count = 0;
-        for r in &receivers {
-            first.push(count as u32);
-            count += r.1.len();
-        }
         let tables = receivers
             .par_iter()
-            .zip(&first)
-            .map(|(r, &t0)| {
-                let mut table = EdgeTable::new(height);
-                for (k, polygon) in r.1.iter().enumerate() {
-                    for ring in rings_of(polygon) {
-                        table.add_ring(t0 + k as u32, ring);
-                    }
+            .map(|(receiver, polygons)| {
+                let mut table = ReceiverTable::new(*receiver, height, keep_rings);
+                for polygon in polygons {
+                    table.add_rings(rings_of(polygon));
                 }
                 table.finish();
                 table
             })
             .collect();
-        let slot = receivers.iter().enumerate().map(|(i, r)| (r.0, Slot::Table(i as u32))).collect();
-        let rings = if keep_rings {
-            receivers.iter().flat_map(|r| r.1.iter().flat_map(|p| rings_of(p).iter().cloned())).collect()
-        } else {
-            Vec::new()
-        };
-        Overlay { height, tables, slot, count, rings, keep_rings }
+        Overlay::from_tables(height, keep_rings, tables)
+    }
+
+    /// An overlay of receivers' finished tables (each receiver once), tagged in the order
+    /// given: table `k`'s polygon `i` gets tag `i` plus the number of polygons before it.
+    pub fn from_tables(height: u32, keep_rings: bool, tables: Vec<ReceiverTable>) -> Self {
+        let mut overlay = Overlay::new(height, keep_rings);
+        for t in tables.into_iter().filter(|t| t.count > 0) {
+            overlay.slot.insert(t.receiver, Slot::Table(overlay.tables.len() as u32));
+            overlay.base.push(overlay.count as u32);
+            overlay.count += t.count as usize;
+            overlay.tables.push(t.table);
+            overlay.rings.extend(t.rings);
+        }
+        overlay
     }
 
     /// Adds, for each of `receivers`, one polygon that covers it whole (its outline is the
@@ -199,7 +255,7 @@ impl OverlayWalker<'_> {
         let cached = &mut self.lines[slot as usize];
         if cached.line != Some(line) {
             let aet = self.active[slot as usize].get_or_insert_with(|| ActiveEdges::new(table, line..end));
-            cached.pair(aet.advance_to(line), &mut self.open);
+            cached.pair(aet.advance_to(line), &mut self.open, self.overlay.base[slot as usize]);
             cached.line = Some(line);
         }
         // The intervals starting before the run's end, from the first whose reach passes
@@ -213,15 +269,16 @@ impl OverlayWalker<'_> {
 }
 
 impl LineIntervals {
-    /// Pairs a line's crossings (sorted by x) into each polygon's covered intervals.
-    fn pair(&mut self, crossings: &[crate::scan::Crossing], open: &mut OpenSet) {
+    /// Pairs a line's crossings (sorted by x) into each polygon's covered intervals, tagging
+    /// each with `base` plus its edges' tag.
+    fn pair(&mut self, crossings: &[crate::scan::Crossing], open: &mut OpenSet, base: u32) {
         self.all.clear();
         open.clear();
         for c in crossings {
             let at = boundary(c.x, u32::MAX);
             if let Some(start) = open.toggle(c.tag, at) {
                 if start < at {
-                    self.all.push(Interval { start, end: at, tag: c.tag });
+                    self.all.push(Interval { start, end: at, tag: base + c.tag });
                 }
             }
         }
