@@ -144,6 +144,24 @@ pub struct EdgeTable {
     within: Option<Range<u32>>,
 }
 
+/// A table with at least this many edges is sorted by all threads.
+const PARALLEL_SORT: usize = 1 << 16;
+
+/// Places the `edges` that start on the table's lines `lines` (counted from `lo`, the
+/// table's first line) into `out`, which holds exactly those lines' buckets, in order.
+fn scatter(edges: &[Edge], lo: u32, bucket: &[u32], lines: Range<usize>, out: &mut [Edge]) {
+    let base = bucket[lines.start];
+    let mut next: Vec<u32> = bucket[lines.clone()].iter().map(|&b| b - base).collect();
+    for e in edges {
+        let line = (e.first - lo) as usize;
+        if lines.contains(&line) {
+            let slot = &mut next[line - lines.start];
+            out[*slot as usize] = *e;
+            *slot += 1;
+        }
+    }
+}
+
 /// An edge spanning at most this many lines that starts this far above a band has ended
 /// before it.
 const LONG_EDGE: u32 = 32;
@@ -212,8 +230,9 @@ impl EdgeTable {
         }
     }
 
-    /// Sorts the edges into buckets by first line (a counting sort). Call it after the last
-    /// `add_ring` and before walking the table.
+    /// Sorts the edges into buckets by first line (a counting sort, stable: a line's edges
+    /// keep the order they were added in). Call it after the last `add_ring` and before
+    /// walking the table.
     pub fn finish(&mut self) {
         if self.built {
             return;
@@ -224,31 +243,79 @@ impl EdgeTable {
             self.bucket.clear();
             return;
         }
-        let lo = self.edges.iter().map(|e| e.first).min().unwrap_or(0);
-        let hi = self.edges.iter().map(|e| e.end).max().unwrap_or(0);
+        let threads = rayon::current_num_threads();
+        let parallel = threads > 1 && self.edges.len() >= PARALLEL_SORT;
+        let (lo, hi) = if parallel {
+            self.edges
+                .par_iter()
+                .map(|e| (e.first, e.end))
+                .reduce(|| (u32::MAX, 0), |a, b| (a.0.min(b.0), a.1.max(b.1)))
+        } else {
+            self.edges.iter().fold((u32::MAX, 0), |(lo, hi), e| (lo.min(e.first), hi.max(e.end)))
+        };
         self.lines = lo..hi.max(lo);
         let n = (self.lines.end - lo) as usize;
         self.bucket.clear();
         self.bucket.resize(n + 1, 0);
-        for e in &self.edges {
-            self.bucket[(e.first - lo) as usize + 1] += 1;
+        let count = |edges: &[Edge], per_line: &mut [u32]| {
+            for e in edges {
+                per_line[(e.first - lo) as usize] += 1;
+            }
+        };
+        if parallel {
+            let per_line = self
+                .edges
+                .par_chunks(PARALLEL_SORT)
+                .map(|chunk| {
+                    let mut per_line = vec![0u32; n];
+                    count(chunk, &mut per_line);
+                    per_line
+                })
+                .reduce_with(|mut a, b| {
+                    a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+                    a
+                })
+                .unwrap_or_default();
+            self.bucket[1..].copy_from_slice(&per_line);
+        } else {
+            count(&self.edges, &mut self.bucket[1..]);
         }
         for i in 0..n {
             self.bucket[i + 1] += self.bucket[i];
         }
-        let mut next = self.bucket.clone();
         let mut sorted = std::mem::take(&mut self.spare);
         sorted.clear();
         sorted.resize(self.edges.len(), self.edges[0]);
-        for e in &self.edges {
-            let slot = &mut next[(e.first - lo) as usize];
-            sorted[*slot as usize] = *e;
-            *slot += 1;
+        if parallel {
+            self.scatter_in_bands(&mut sorted, threads);
+        } else {
+            scatter(&self.edges, lo, &self.bucket, 0..n, &mut sorted);
         }
         self.spare = std::mem::replace(&mut self.edges, sorted);
         self.long.clear();
         let long = self.edges.iter().enumerate().filter(|(_, e)| e.end - e.first > LONG_EDGE);
         self.long.extend(long.map(|(i, _)| i as u32));
+    }
+
+    /// The scatter of the counting sort, shared among `bands` threads: the lines are cut into
+    /// bands holding about as many edges each, and each band reads every edge and places
+    /// those that start in it, in order, in its own stretch of `sorted`.
+    fn scatter_in_bands(&self, sorted: &mut [Edge], bands: usize) {
+        let (lo, n, total) = (self.lines.start, self.bucket.len() - 1, self.edges.len());
+        let mut cuts: Vec<usize> =
+            (0..=bands).map(|k| self.bucket.partition_point(|&b| (b as usize) < total * k / bands)).collect();
+        cuts[0] = 0;
+        cuts[bands] = n;
+        let mut stretches = Vec::with_capacity(bands);
+        let mut rest = sorted;
+        for w in cuts.windows(2) {
+            let lines = w[0]..w[1].max(w[0]);
+            let len = (self.bucket[lines.end] - self.bucket[lines.start]) as usize;
+            let (stretch, tail) = rest.split_at_mut(len);
+            stretches.push((lines, stretch));
+            rest = tail;
+        }
+        stretches.into_par_iter().for_each(|(lines, stretch)| scatter(&self.edges, lo, &self.bucket, lines, stretch));
     }
 
     /// Every edge as (tag, first line, end line, x at its top, y at its top, dx/dy).
@@ -648,6 +715,41 @@ impl OpenSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_large_table_sorted_by_two_threads_is_the_table_one_thread_sorts() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+        // Triangles bunched toward the top, so that the bands hold unequal numbers of lines.
+        let rings: Vec<Vec<DVec2>> = (0..3 * PARALLEL_SORT / 2)
+            .map(|_| {
+                let y = rng.gen_range(0.0f64..1.0).powi(3) * 1000.0;
+                let at = DVec2::new(rng.gen_range(0.0..1900.0), y);
+                (0..3).map(|_| at + DVec2::new(rng.gen_range(0.0..20.0), rng.gen_range(0.0..60.0))).collect()
+            })
+            .collect();
+        let sorted_by = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let mut t = EdgeTable::new(1080);
+                t.add_rings(&rings);
+                t.finish();
+                assert!(t.len() >= PARALLEL_SORT);
+                (
+                    t.edges().map(|e| (e.0, e.1, e.2, e.3.to_bits())).collect::<Vec<_>>(),
+                    t.bucket.clone(),
+                    t.long.clone(),
+                )
+            })
+        };
+        let one = sorted_by(1);
+        for threads in [2, 3] {
+            assert_eq!(sorted_by(threads), one, "{threads} threads");
+        }
+        // Stable: each line's edges in the order they were added (by tag, as added).
+        let edges = &one.0;
+        assert!(edges.windows(2).all(|w| (w[0].1, w[0].0) <= (w[1].1, w[1].0)));
+    }
 
     fn spans(ring: &[DVec2], w: u32, h: u32) -> Vec<(u32, u32, u32)> {
         let mut t = EdgeTable::new(h);

@@ -123,6 +123,12 @@ pub struct ShadowPolygon {
     pub owner_face: Option<u32>,
 }
 
+/// The most items (edges, polygons, shadow polygons) one piece of a parallel loop takes.
+/// Their costs differ from place to place in the scene (a culled polygon costs nothing), and
+/// rayon's own cut leaves a few long pieces: a thread that runs out of work would wait for
+/// the last.
+const PIECE: usize = 4096;
+
 /// The shadow polygons of one light sample for a count taken by `counting`.
 fn shadow_polygons(
     ctx: &ShadowContext,
@@ -144,6 +150,7 @@ fn shadow_polygons(
     let mut out: Vec<ShadowPolygon> = adjacency
         .edges
         .par_iter()
+        .with_max_len(PIECE)
         .filter_map(|e| {
             let sharing = &adjacency.sharing[e.first as usize..(e.first + e.count) as usize];
             if !sharing.iter().any(|s| casts(s.poly as usize)) {
@@ -159,6 +166,7 @@ fn shadow_polygons(
     let caps = adjacency
         .merged
         .par_iter()
+        .with_max_len(PIECE)
         .filter(|&&p| casts(p as usize))
         .map_init(Projector::default, |proj, &p| b.caps(proj, ctx.scene.verts(p as usize), p as usize, None));
     out.par_extend(caps.flat_map_iter(|c| c.into_iter().flatten()));
@@ -177,14 +185,26 @@ fn shadow_polygons(
     counters.add("polygons_apart", adjacency.apart.len() as u64);
     counters.add("sides_weight_1", weight1);
     counters.add("sides_weight_2", weight2);
-    for (part, name) in [
-        (Part::Side, "shadow_polygons_side"),
-        (Part::FrontCap, "shadow_polygons_front_cap"),
-        (Part::BackCap, "shadow_polygons_back_cap"),
-        (Part::NearCap, "shadow_polygons_near_cap"),
-        (Part::FarCap, "shadow_polygons_far_cap"),
-    ] {
-        counters.add(name, out.iter().filter(|p| p.part == part).count() as u64);
+    let parts = [Part::Side, Part::FrontCap, Part::BackCap, Part::NearCap, Part::FarCap];
+    let per_part = out
+        .par_iter()
+        .fold(
+            || [0u64; 5],
+            |mut n, p| {
+                n[parts.iter().position(|&q| q == p.part).unwrap_or(0)] += 1;
+                n
+            },
+        )
+        .reduce(|| [0u64; 5], |a, b| std::array::from_fn(|k| a[k] + b[k]));
+    let names = [
+        "shadow_polygons_side",
+        "shadow_polygons_front_cap",
+        "shadow_polygons_back_cap",
+        "shadow_polygons_near_cap",
+        "shadow_polygons_far_cap",
+    ];
+    for (name, n) in names.into_iter().zip(per_part) {
+        counters.add(name, n);
     }
     out
 }
@@ -716,6 +736,7 @@ impl ScreenVolumes {
         // Each shadow polygon is put through the camera on its own: in parallel, in order.
         let screen: Vec<Screened> = shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), counters)
             .into_par_iter()
+            .with_max_len(PIECE)
             .map_init(Scratch::default, |scratch, sp| scratch.screen(view, hull.as_ref(), &sp))
             .collect();
         let outside = screen.iter().filter(|s| matches!(s, Screened::OutOfSight)).count() as u64;
