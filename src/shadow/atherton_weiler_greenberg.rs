@@ -406,28 +406,39 @@ impl Sorting {
     }
 
     /// The pieces still waiting whose insides may meet `front`'s (front polygon `fi`), each
-    /// once. Pieces that only share an edge with it (its neighbours on a mesh) are left out,
-    /// or, where [`cut`] splits them, found apart by the split: nothing of them is inside it.
+    /// once, in the order they were added. Pieces that only share an edge with it (its
+    /// neighbours on a mesh) are left out, or, where [`cut`] splits them, found apart by the
+    /// split: nothing of them is inside it.
     fn overlapping(&mut self, front: &Piece, fi: u32, stats: &Pass1) -> Vec<u32> {
+        // Convex pairs are tested as they are split; without splits, pairs are tested as
+        // they are cut ([`cut_all`]).
+        let meets = |p: &Piece| {
+            p.overlaps(front)
+                && (splits(p, front, stats) || !stats.convex_split || !regions_apart(&p.region, &front.region))
+        };
+        let cells = self.cells(front.bounds).collect::<smallvec::SmallVec<[usize; 8]>>();
+        if cells.len() * 4 >= self.grid.len() {
+            // A front polygon over much of the grid (a stack of large polygons): the pieces
+            // are fewer to read than the cells' lists.
+            let live = self.arena.iter().enumerate().filter_map(|(q, p)| Some((q as u32, p.as_ref()?)));
+            return live.filter(|(_, p)| meets(p)).map(|(q, _)| q).collect();
+        }
         let mut found = Vec::new();
-        for c in self.cells(front.bounds).collect::<smallvec::SmallVec<[usize; 8]>>() {
+        for c in cells {
             // Pieces taken since (hidden, or sorted) leave the cell as it is read.
             let (arena, stamp) = (&self.arena, &mut self.stamp);
             self.grid[c].retain(|&q| {
                 let Some(p) = &arena[q as usize] else { return false };
                 if stamp[q as usize] != fi {
                     stamp[q as usize] = fi;
-                    // Convex pairs are tested as they are split; without splits, pairs are
-                    // tested as they are cut ([`cut_all`]).
-                    if p.overlaps(front)
-                        && (splits(p, front, stats) || !stats.convex_split || !regions_apart(&p.region, &front.region))
-                    {
+                    if meets(p) {
                         found.push(q);
                     }
                 }
                 true
             });
         }
+        found.sort_unstable();
         found
     }
 }
