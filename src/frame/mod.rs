@@ -20,7 +20,7 @@ pub const BACKGROUND: u32 = u32::MAX;
 /// let k = (24 * f.width + 32) as usize; // the pixel at (32, 24)
 /// assert_ne!(f.id[k], BACKGROUND); // the face seen there (the floor or a cube)
 /// assert!((0.0..=1.0).contains(&f.light[0][k])); // how much of light 0 reaches it
-/// f.save_png("target/cubes.png".as_ref(), Some(2.2))?;
+/// f.save_png(&std::env::temp_dir().join("umbra-cubes.png"), Some(2.2))?;
 /// # Ok::<(), umbra::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]

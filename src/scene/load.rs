@@ -244,8 +244,9 @@ impl Scene {
     /// let scene = Scene::load("scenes/cornell.toml")?;
     /// assert!(scene.lights().len() >= 1);
     ///
-    /// std::fs::write("target/broken.toml", "[camera]\neye = [0, 0, 1]\ntarget = [0, 0, 0]\nfov = 45\n")?;
-    /// match Scene::load("target/broken.toml") {
+    /// let broken = std::env::temp_dir().join("umbra-broken.toml");
+    /// std::fs::write(&broken, "[camera]\neye = [0, 0, 1]\ntarget = [0, 0, 0]\nfov = 45\n")?;
+    /// match Scene::load(&broken) {
     ///     Err(Error::Load { loc, message }) => assert_eq!((loc.line, message.contains("fov")), (Some(4), true)),
     ///     other => panic!("{other:?}"),
     /// }
