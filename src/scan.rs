@@ -42,6 +42,9 @@ struct Edge {
 }
 
 impl Edge {
+    /// A placeholder, overwritten before it is read.
+    const NONE: Edge = Edge { x_top: 0.0, y_top: 0.0, dxdy: 0.0, first: 0, end: 0, tag: 0 };
+
     /// The edge from `a` to `b` in an image `height` lines high; `None` when it is
     /// horizontal, not finite, or active on no line.
     fn new(tag: u32, a: DVec2, b: DVec2, height: u32) -> Option<Edge> {
@@ -144,6 +147,22 @@ pub struct EdgeTable {
     within: Option<Range<u32>>,
 }
 
+/// The edges of `rings`, ring `i` tagged `first + i`, in order.
+fn piece_edges<'a>(
+    first: usize,
+    rings: &'a [Vec<DVec2>],
+    height: u32,
+    within: &'a Option<Range<u32>>,
+) -> impl Iterator<Item = Edge> + 'a {
+    rings.iter().enumerate().flat_map(move |(i, ring)| {
+        let from = ring.last().into_iter().chain(ring);
+        from.zip(ring).filter_map(move |(&a, &b)| Edge::within((first + i) as u32, a, b, height, within))
+    })
+}
+
+/// The most rings one piece of [`EdgeTable::add_rings`] takes.
+const RINGS_PER_PIECE: usize = 4096;
+
 /// A table with at least this many edges is sorted by all threads.
 const PARALLEL_SORT: usize = 1 << 16;
 
@@ -205,22 +224,27 @@ impl EdgeTable {
 
     /// Adds the rings of polygons `0..rings.len()` (ring `i` with tag `i`), their edges
     /// worked out in parallel: the table is the one [`EdgeTable::add_ring`] would build
-    /// adding them in order.
+    /// adding them in order. The rings are taken in pieces: each piece counts its edges,
+    /// then writes them into its own stretch of the table.
     pub fn add_rings(&mut self, rings: &[Vec<DVec2>]) {
         let (height, within) = (self.height, &self.within);
-        let edges: Vec<Edge> = rings
-            .par_iter()
-            .enumerate()
-            .flat_map_iter(|(tag, ring)| {
-                let from = ring.last().into_iter().chain(ring);
-                from.zip(ring).filter_map(move |(&a, &b)| Edge::within(tag as u32, a, b, height, within))
-            })
-            .collect();
-        if self.edges.is_empty() {
-            self.edges = edges;
-        } else {
-            self.edges.extend(edges);
+        let piece_edges = |k: usize, piece| piece_edges(k * RINGS_PER_PIECE, piece, height, within);
+        let counts: Vec<usize> =
+            rings.par_chunks(RINGS_PER_PIECE).enumerate().map(|(k, piece)| piece_edges(k, piece).count()).collect();
+        let start = self.edges.len();
+        self.edges.par_extend(rayon::iter::repeat_n(Edge::NONE, counts.iter().sum()));
+        let mut stretches = Vec::with_capacity(counts.len());
+        let mut rest = &mut self.edges[start..];
+        for &n in &counts {
+            let (stretch, tail) = rest.split_at_mut(n);
+            stretches.push(stretch);
+            rest = tail;
         }
+        rings.par_chunks(RINGS_PER_PIECE).zip(stretches).enumerate().for_each(|(k, (piece, stretch))| {
+            for (slot, e) in stretch.iter_mut().zip(piece_edges(k, piece)) {
+                *slot = e;
+            }
+        });
         self.built = false;
     }
 
@@ -717,7 +741,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_large_table_sorted_by_two_threads_is_the_table_one_thread_sorts() {
+    fn a_large_table_built_and_sorted_by_several_threads_is_the_table_one_thread_builds() {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
         // Triangles bunched toward the top, so that the bands hold unequal numbers of lines.
@@ -746,6 +770,14 @@ mod tests {
         for threads in [2, 3] {
             assert_eq!(sorted_by(threads), one, "{threads} threads");
         }
+        // And the table that adding the rings one by one builds.
+        let mut by_one = EdgeTable::new(1080);
+        for (tag, ring) in rings.iter().enumerate() {
+            by_one.add_ring(tag as u32, ring);
+        }
+        by_one.finish();
+        let listed: Vec<_> = by_one.edges().map(|e| (e.0, e.1, e.2, e.3.to_bits())).collect();
+        assert_eq!((listed, by_one.bucket.clone(), by_one.long.clone()), one);
         // Stable: each line's edges in the order they were added (by tag, as added).
         let edges = &one.0;
         assert!(edges.windows(2).all(|w| (w[0].1, w[0].0) <= (w[1].1, w[1].0)));

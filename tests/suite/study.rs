@@ -6,6 +6,9 @@ use umbra::{Scene, ShadowMethod};
 
 fn tmp(name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("umbra-study-{}-{name}", std::process::id()));
+    // Fresh: a folder left by an earlier run whose process had the same id would hold
+    // files that the commands refuse to overwrite.
+    let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
 }
