@@ -291,6 +291,11 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
 /// Fewest pieces one front polygon cuts in parallel.
 const PARALLEL_CUTS: usize = 16;
 
+/// The most cuts one piece of the parallel loop takes: a cut's cost varies with the pieces'
+/// shapes, and with rayon's own cut into a few long pieces one thread waits for the other
+/// at every front polygon.
+const CUTS_PER_PIECE: usize = 4;
+
 /// Each of `taken` cut by `front`'s outline ([`cut`]), in order: in parallel where there are
 /// many and Weiler and Atherton's clipper cuts them (a stack of polygons that all overlap
 /// one another); splits by edges are too quick to share out.
@@ -321,6 +326,7 @@ fn cut_all(
     let flags = Pass1 { convex_split: stats.convex_split, ..Default::default() };
     let done: Vec<(u32, Piece, Option<Parts>, Pass1)> = taken
         .into_par_iter()
+        .with_max_len(CUTS_PER_PIECE)
         .map(|(q, p)| {
             let mut st = Pass1 { ..flags };
             let parts = cut_unless_apart(&p, &mut st)?;

@@ -159,11 +159,14 @@ impl Overlay {
         Overlay::from_tables(height, keep_rings, tables)
     }
 
-    /// An overlay of receivers' finished tables (each receiver once), tagged in the order
-    /// given: table `k`'s polygon `i` gets tag `i` plus the number of polygons before it.
+    /// An overlay of receivers' tables (each receiver once), tagged in the order given:
+    /// table `k`'s polygon `i` gets tag `i` plus the number of polygons before it. Tables
+    /// are best finished where they were built, in parallel; any that is not is finished
+    /// here.
     pub fn from_tables(height: u32, keep_rings: bool, tables: Vec<ReceiverTable>) -> Self {
         let mut overlay = Overlay::new(height, keep_rings);
-        for t in tables.into_iter().filter(|t| t.count > 0) {
+        for mut t in tables.into_iter().filter(|t| t.count > 0) {
+            t.finish();
             overlay.slot.insert(t.receiver, Slot::Table(overlay.tables.len() as u32));
             overlay.base.push(overlay.count as u32);
             overlay.count += t.count as usize;
