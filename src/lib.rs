@@ -51,6 +51,7 @@ mod error;
 mod frame;
 pub mod generate;
 mod geometry;
+mod pieces;
 mod pool;
 mod progress;
 mod raster;

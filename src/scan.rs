@@ -18,6 +18,7 @@
 //! and no drift on long, nearly horizontal edges. Two polygons that share an edge compute
 //! bit-identical crossings because the edge is always taken from its upper vertex.
 
+use crate::pieces::stretches;
 use glam::DVec2;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -233,13 +234,7 @@ impl EdgeTable {
             rings.par_chunks(RINGS_PER_PIECE).enumerate().map(|(k, piece)| piece_edges(k, piece).count()).collect();
         let start = self.edges.len();
         self.edges.par_extend(rayon::iter::repeat_n(Edge::NONE, counts.iter().sum()));
-        let mut stretches = Vec::with_capacity(counts.len());
-        let mut rest = &mut self.edges[start..];
-        for &n in &counts {
-            let (stretch, tail) = rest.split_at_mut(n);
-            stretches.push(stretch);
-            rest = tail;
-        }
+        let stretches = stretches(&mut self.edges[start..], counts);
         rings.par_chunks(RINGS_PER_PIECE).zip(stretches).enumerate().for_each(|(k, (piece, stretch))| {
             for (slot, e) in stretch.iter_mut().zip(piece_edges(k, piece)) {
                 *slot = e;
@@ -330,16 +325,13 @@ impl EdgeTable {
             (0..=bands).map(|k| self.bucket.partition_point(|&b| (b as usize) < total * k / bands)).collect();
         cuts[0] = 0;
         cuts[bands] = n;
-        let mut stretches = Vec::with_capacity(bands);
-        let mut rest = sorted;
-        for w in cuts.windows(2) {
-            let lines = w[0]..w[1].max(w[0]);
-            let len = (self.bucket[lines.end] - self.bucket[lines.start]) as usize;
-            let (stretch, tail) = rest.split_at_mut(len);
-            stretches.push((lines, stretch));
-            rest = tail;
-        }
-        stretches.into_par_iter().for_each(|(lines, stretch)| scatter(&self.edges, lo, &self.bucket, lines, stretch));
+        let bands: Vec<Range<usize>> = cuts.windows(2).map(|w| w[0]..w[1].max(w[0])).collect();
+        let lengths = bands.iter().map(|lines| (self.bucket[lines.end] - self.bucket[lines.start]) as usize);
+        let stretches = stretches(sorted, lengths);
+        bands
+            .into_par_iter()
+            .zip(stretches)
+            .for_each(|(lines, stretch)| scatter(&self.edges, lo, &self.bucket, lines, stretch));
     }
 
     /// Every edge as (tag, first line, end line, x at its top, y at its top, dx/dy).

@@ -50,6 +50,7 @@
 use super::projection::{light_side, unseen, Projector, Target};
 use super::ShadowContext;
 use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane};
+use crate::pieces::stretches;
 use crate::pool::Stash;
 use crate::scene::LightSample;
 use crate::stats::Counters;
@@ -739,18 +740,45 @@ impl ScreenVolumes {
             .with_max_len(PIECE)
             .map_init(Scratch::default, |scratch, sp| scratch.screen(view, hull.as_ref(), &sp))
             .collect();
-        let outside = screen.iter().filter(|s| matches!(s, Screened::OutOfSight)).count() as u64;
-        let (polys, rings) = screen
-            .into_iter()
-            .filter_map(|s| match s {
-                Screened::On(poly, ring) => Some((poly, ring)),
-                _ => None,
-            })
-            .unzip();
-        let out = ScreenVolumes { polys, rings };
+        let outside = screen.par_iter().filter(|s| matches!(s, Screened::OutOfSight)).count() as u64;
+        let out = ScreenVolumes::on_screen(screen);
         counters.add("screen_shadow_polygons", out.polys.len() as u64);
         counters.add("sides_outside_sight", outside);
         out
+    }
+}
+
+impl ScreenVolumes {
+    /// The polygons of `screen` that are on screen, in order, moved out by pieces in
+    /// parallel: each piece counts its own, then fills its stretch of both lists.
+    fn on_screen(mut screen: Vec<Screened>) -> ScreenVolumes {
+        let counts: Vec<usize> = screen
+            .par_chunks(PIECE)
+            .map(|piece| piece.iter().filter(|s| matches!(s, Screened::On(..))).count())
+            .collect();
+        let total = counts.iter().sum();
+        let none = ScreenShadowPolygon {
+            depth: DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
+            sign: 0,
+            near_cap: false,
+            lies_on: NONE,
+            owner_face: NONE,
+        };
+        let mut polys = Vec::new();
+        polys.par_extend(rayon::iter::repeat_n(none, total));
+        let mut rings = Vec::new();
+        rings.par_extend(rayon::iter::repeat_n(Vec::new(), total));
+        let pieces = stretches(&mut polys, counts.iter().copied()).into_par_iter().zip(stretches(&mut rings, counts));
+        screen.par_chunks_mut(PIECE).zip(pieces).for_each(|(piece, (polys, rings))| {
+            let on = piece.iter_mut().filter_map(|s| match std::mem::replace(s, Screened::Off) {
+                Screened::On(poly, ring) => Some((poly, ring)),
+                _ => None,
+            });
+            for ((p, r), (poly, ring)) in polys.iter_mut().zip(rings.iter_mut()).zip(on) {
+                (*p, *r) = (poly, ring);
+            }
+        });
+        ScreenVolumes { polys, rings }
     }
 }
 

@@ -1,0 +1,35 @@
+//! Parallel loops cut into pieces that two threads can share evenly.
+//!
+//! Rayon cuts a loop into a few long pieces, one or two per thread, and a thread that has
+//! finished its own waits while the other works through its last. Where items differ in
+//! cost (a receiver under a sphere's shadow and one on its lit side, a culled polygon and a
+//! kept one), the loops of the shadow stages cap their pieces with `with_max_len`. Where
+//! each piece writes a list whose length only the piece knows, it counts first, and then
+//! fills its own stretch of one list ([`stretches`]); the list is the one a serial loop
+//! would make, with no pass that joins the pieces' lists on one thread.
+
+/// `list` cut, from its start, into consecutive stretches of the given lengths (which sum
+/// to at most its length).
+pub(crate) fn stretches<T>(mut list: &mut [T], lengths: impl IntoIterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut out = Vec::new();
+    for n in lengths {
+        let (stretch, rest) = std::mem::take(&mut list).split_at_mut(n);
+        out.push(stretch);
+        list = rest;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stretches_follow_one_another() {
+        let mut list: Vec<u32> = (0..10).collect();
+        let cut = stretches(&mut list, [3, 0, 5]);
+        let lens: Vec<usize> = cut.iter().map(|s| s.len()).collect();
+        assert_eq!(lens, [3, 0, 5]);
+        assert_eq!((cut[0][0], cut[2][0], cut[2][4]), (0, 3, 7));
+    }
+}
