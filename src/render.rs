@@ -368,7 +368,7 @@ fn shade_frame(
     let chunk = (band * w) as usize;
     let mut light_rows: Vec<_> = frame.light.iter_mut().map(|l| l.chunks_mut(chunk)).collect();
     let mut test_rows = frame.counters.as_mut().map(|c| c.shadow_tests.chunks_mut(chunk));
-    let jobs: Vec<Band> = frame
+    let mut jobs: Vec<Band> = frame
         .color
         .chunks_mut(chunk)
         .zip(frame.id.chunks_mut(chunk))
@@ -381,7 +381,15 @@ fn shade_frame(
             tests: test_rows.as_mut().and_then(|rows| rows.next()),
         })
         .collect();
+    // Neighbouring bands cost alike (a mesh in the middle of the frame makes a few heavy
+    // bands in a row), and rayon first hands each thread a run of consecutive tasks: taken
+    // in the order 0, T, 2T, ..., 1, T + 1, ... (T threads), each thread's run holds every
+    // T-th band. Each band is a task of its own, so a thread that finishes early takes
+    // over single bands.
+    let threads = rayon::current_num_threads().max(1) as u32;
+    jobs.sort_by_key(|j| ((j.y0 / band) % threads, j.y0));
     jobs.into_par_iter()
+        .with_max_len(1)
         .map(|job| {
             let lines = job.y0..job.y0 + (job.id.len() / w as usize) as u32;
             let work = shade_band(ctx, shadows, &shader, job);
