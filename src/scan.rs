@@ -148,6 +148,18 @@ pub struct EdgeTable {
     within: Option<Range<u32>>,
 }
 
+/// The edges of the closed `ring` of polygon `tag`, in order, in an image `height` lines
+/// high, cut to the lines `within` if given.
+fn ring_edges<'a>(
+    tag: u32,
+    ring: &'a [DVec2],
+    height: u32,
+    within: &'a Option<Range<u32>>,
+) -> impl Iterator<Item = Edge> + 'a {
+    let from = ring.last().into_iter().chain(ring);
+    from.zip(ring).filter_map(move |(&a, &b)| Edge::within(tag, a, b, height, within))
+}
+
 /// The edges of `rings`, ring `i` tagged `first + i`, in order.
 fn piece_edges<'a>(
     first: usize,
@@ -155,10 +167,7 @@ fn piece_edges<'a>(
     height: u32,
     within: &'a Option<Range<u32>>,
 ) -> impl Iterator<Item = Edge> + 'a {
-    rings.iter().enumerate().flat_map(move |(i, ring)| {
-        let from = ring.last().into_iter().chain(ring);
-        from.zip(ring).filter_map(move |(&a, &b)| Edge::within((first + i) as u32, a, b, height, within))
-    })
+    rings.iter().enumerate().flat_map(move |(i, ring)| ring_edges((first + i) as u32, ring, height, within))
 }
 
 /// The most rings one piece of [`EdgeTable::add_rings`] takes.
@@ -214,12 +223,7 @@ impl EdgeTable {
     /// Adds the edges of a closed ring of polygon `tag`. Rings of one tag combine by the
     /// even-odd rule.
     pub fn add_ring(&mut self, tag: u32, ring: &[DVec2]) {
-        let Some(&last) = ring.last() else { return };
-        let mut a = last;
-        for &b in ring {
-            self.add_edge(tag, a, b);
-            a = b;
-        }
+        self.edges.extend(ring_edges(tag, ring, self.height, &self.within));
         self.built = false;
     }
 
@@ -241,12 +245,6 @@ impl EdgeTable {
             }
         });
         self.built = false;
-    }
-
-    fn add_edge(&mut self, tag: u32, a: DVec2, b: DVec2) {
-        if let Some(e) = Edge::within(tag, a, b, self.height, &self.within) {
-            self.edges.push(e);
-        }
     }
 
     /// Sorts the edges into buckets by first line (a counting sort, stable: a line's edges

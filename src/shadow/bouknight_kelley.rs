@@ -123,12 +123,15 @@ fn shadow_polygons(
         .par_iter()
         .with_max_len(RECEIVERS_PER_PIECE)
         .map_init(
-            || (Projector::default(), stamps.lease(), [Vec::new(), Vec::new()], Vec::new(), Vec::new()),
-            |(proj, stamp, scratch, ring, candidates), &b| {
+            || {
+                let mut stamp = stamps.lease();
                 if stamp.len() != n {
                     stamp.clear();
                     stamp.resize(n, u32::MAX);
                 }
+                (Projector::default(), stamp, [Vec::new(), Vec::new()], Vec::new(), Vec::new())
+            },
+            |(proj, stamp, scratch, ring, candidates), &b| {
                 let t = Instant::now();
                 match &grid {
                     Some(g) => g.candidates(b, stamp, candidates),

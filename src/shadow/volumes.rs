@@ -89,7 +89,8 @@ impl Counting {
 
 crate::error::named!(Counting, "count");
 
-/// What part of a volume's boundary a shadow polygon is.
+/// What part of a volume's boundary a shadow polygon is (the counters by part follow this
+/// order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Part {
     /// A side, on an edge pushed away from the light.
@@ -186,13 +187,13 @@ fn shadow_polygons(
     counters.add("polygons_apart", adjacency.apart.len() as u64);
     counters.add("sides_weight_1", weight1);
     counters.add("sides_weight_2", weight2);
-    let parts = [Part::Side, Part::FrontCap, Part::BackCap, Part::NearCap, Part::FarCap];
+    // Counted by part in one pass, in the order `Part` lists its parts.
     let per_part = out
         .par_iter()
         .fold(
             || [0u64; 5],
             |mut n, p| {
-                n[parts.iter().position(|&q| q == p.part).unwrap_or(0)] += 1;
+                n[p.part as usize] += 1;
                 n
             },
         )
@@ -740,22 +741,24 @@ impl ScreenVolumes {
             .with_max_len(PIECE)
             .map_init(Scratch::default, |scratch, sp| scratch.screen(view, hull.as_ref(), &sp))
             .collect();
-        let outside = screen.par_iter().filter(|s| matches!(s, Screened::OutOfSight)).count() as u64;
-        let out = ScreenVolumes::on_screen(screen);
+        let (out, outside) = ScreenVolumes::on_screen(screen);
         counters.add("screen_shadow_polygons", out.polys.len() as u64);
         counters.add("sides_outside_sight", outside);
         out
     }
-}
 
-impl ScreenVolumes {
     /// The polygons of `screen` that are on screen, in order, moved out by pieces in
-    /// parallel: each piece counts its own, then fills its stretch of both lists.
-    fn on_screen(mut screen: Vec<Screened>) -> ScreenVolumes {
-        let counts: Vec<usize> = screen
-            .par_chunks(PIECE)
-            .map(|piece| piece.iter().filter(|s| matches!(s, Screened::On(..))).count())
-            .collect();
+    /// parallel: each piece counts its own, then fills its stretch of both lists. Also how
+    /// many sides were wholly out of sight.
+    fn on_screen(mut screen: Vec<Screened>) -> (ScreenVolumes, u64) {
+        let tally = |piece: &[Screened]| {
+            piece.iter().fold((0, 0), |(on, out), s| match s {
+                Screened::On(..) => (on + 1, out),
+                Screened::OutOfSight => (on, out + 1),
+                Screened::Off => (on, out),
+            })
+        };
+        let (counts, outside): (Vec<usize>, Vec<u64>) = screen.par_chunks(PIECE).map(tally).unzip();
         let total = counts.iter().sum();
         let none = ScreenShadowPolygon {
             depth: DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
@@ -778,7 +781,7 @@ impl ScreenVolumes {
                 (*p, *r) = (poly, ring);
             }
         });
-        ScreenVolumes { polys, rings }
+        (ScreenVolumes { polys, rings }, outside.iter().sum())
     }
 }
 
