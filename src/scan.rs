@@ -18,6 +18,7 @@
 //! and no drift on long, nearly horizontal edges. Two polygons that share an edge compute
 //! bit-identical crossings because the edge is always taken from its upper vertex.
 
+use crate::geometry::RingList;
 use crate::pieces::stretches;
 use glam::DVec2;
 use rayon::prelude::*;
@@ -160,14 +161,14 @@ fn ring_edges<'a>(
     from.zip(ring).filter_map(move |(&a, &b)| Edge::within(tag, a, b, height, within))
 }
 
-/// The edges of `rings`, ring `i` tagged `first + i`, in order.
-fn piece_edges<'a>(
-    first: usize,
-    rings: &'a [Vec<DVec2>],
+/// The edges of rings `piece` of `rings`, ring `i` tagged `i`, in order.
+fn piece_edges<'a, R: RingList + ?Sized>(
+    piece: Range<usize>,
+    rings: &'a R,
     height: u32,
     within: &'a Option<Range<u32>>,
 ) -> impl Iterator<Item = Edge> + 'a {
-    rings.iter().enumerate().flat_map(move |(i, ring)| ring_edges((first + i) as u32, ring, height, within))
+    piece.flat_map(move |i| ring_edges(i as u32, rings.ring(i), height, within))
 }
 
 /// The most rings one piece of [`EdgeTable::add_rings`] takes.
@@ -231,16 +232,20 @@ impl EdgeTable {
     /// worked out in parallel: the table is the one [`EdgeTable::add_ring`] would build
     /// adding them in order. The rings are taken in pieces: each piece counts its edges,
     /// then writes them into its own stretch of the table.
-    pub fn add_rings(&mut self, rings: &[Vec<DVec2>]) {
+    pub(crate) fn add_rings<R: RingList + ?Sized>(&mut self, rings: &R) {
         let (height, within) = (self.height, &self.within);
-        let piece_edges = |k: usize, piece| piece_edges(k * RINGS_PER_PIECE, piece, height, within);
-        let counts: Vec<usize> =
-            rings.par_chunks(RINGS_PER_PIECE).enumerate().map(|(k, piece)| piece_edges(k, piece).count()).collect();
+        let n = rings.count();
+        let pieces = || {
+            (0..n.div_ceil(RINGS_PER_PIECE))
+                .into_par_iter()
+                .map(|k| k * RINGS_PER_PIECE..n.min((k + 1) * RINGS_PER_PIECE))
+        };
+        let counts: Vec<usize> = pieces().map(|piece| piece_edges(piece, rings, height, within).count()).collect();
         let start = self.edges.len();
         self.edges.par_extend(rayon::iter::repeat_n(Edge::NONE, counts.iter().sum()));
         let stretches = stretches(&mut self.edges[start..], counts);
-        rings.par_chunks(RINGS_PER_PIECE).zip(stretches).enumerate().for_each(|(k, (piece, stretch))| {
-            for (slot, e) in stretch.iter_mut().zip(piece_edges(k, piece)) {
+        pieces().zip(stretches).for_each(|(piece, stretch)| {
+            for (slot, e) in stretch.iter_mut().zip(piece_edges(piece, rings, height, within)) {
                 *slot = e;
             }
         });
@@ -302,16 +307,23 @@ impl EdgeTable {
         }
         let mut sorted = std::mem::take(&mut self.spare);
         sorted.clear();
-        sorted.resize(self.edges.len(), self.edges[0]);
+        // A fresh list of millions of edges is first touched here: in parallel, its pages
+        // are found and zeroed by every thread.
         if parallel {
+            sorted.par_extend(rayon::iter::repeat_n(Edge::NONE, self.edges.len()));
             self.scatter_in_bands(&mut sorted, threads);
         } else {
+            sorted.resize(self.edges.len(), Edge::NONE);
             scatter(&self.edges, lo, &self.bucket, 0..n, &mut sorted);
         }
         self.spare = std::mem::replace(&mut self.edges, sorted);
         self.long.clear();
-        let long = self.edges.iter().enumerate().filter(|(_, e)| e.end - e.first > LONG_EDGE);
-        self.long.extend(long.map(|(i, _)| i as u32));
+        let is_long = |(i, e): (usize, &Edge)| (e.end - e.first > LONG_EDGE).then_some(i as u32);
+        if parallel {
+            self.long.par_extend(self.edges.par_iter().enumerate().filter_map(is_long));
+        } else {
+            self.long.extend(self.edges.iter().enumerate().filter_map(is_long));
+        }
     }
 
     /// The scatter of the counting sort, shared among `bands` threads: the lines are cut into
@@ -746,7 +758,7 @@ mod tests {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
                 let mut t = EdgeTable::new(1080);
-                t.add_rings(&rings);
+                t.add_rings(rings.as_slice());
                 t.finish();
                 assert!(t.len() >= PARALLEL_SORT);
                 (
@@ -824,7 +836,7 @@ mod tests {
             for (i, ring) in rings.iter().enumerate() {
                 one.add_ring(i as u32, ring);
             }
-            all.add_rings(&rings);
+            all.add_rings(rings.as_slice());
             assert!(one.len() > 1000, "{}", one.len());
             assert!(one.edges().eq(all.edges()), "band {band:?}");
         }

@@ -6,7 +6,10 @@
 pub mod convex_split;
 pub mod even_odd;
 pub(crate) mod lone_sheets;
+mod rings;
 pub mod weiler_atherton;
+
+pub(crate) use rings::{RingList, Rings};
 
 use glam::{DVec2, DVec3};
 

@@ -97,7 +97,7 @@ impl ShadowStage for Crow<'_> {
         if !self.ctx.keep_outlines {
             return Vec::new();
         }
-        self.samples.first().map_or_else(Vec::new, |s| s.volumes.rings.clone())
+        self.samples.first().map_or_else(Vec::new, |s| s.volumes.rings.iter().map(<[DVec2]>::to_vec).collect())
     }
 }
 

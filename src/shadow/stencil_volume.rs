@@ -60,7 +60,7 @@ impl<'a> StencilVolume<'a> {
                         let lines = y0..(y0 + band).min(h);
                         let mut table = EdgeTable::new(h);
                         let mut n = 0u64;
-                        for (sp, ring) in vols.polys.iter().zip(&vols.rings) {
+                        for (sp, ring) in vols.polys.iter().zip(vols.rings.iter()) {
                             for_each_span(&mut table, &[ring], view.width, h, lines.clone(), |y, x0, x1| {
                                 let yc = y as f64 + 0.5;
                                 for x in x0..x1 {

@@ -49,7 +49,7 @@
 
 use super::projection::{light_side, unseen, Projector, Target};
 use super::ShadowContext;
-use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane};
+use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane, Rings};
 use crate::pieces::stretches;
 use crate::pool::Stash;
 use crate::scene::LightSample;
@@ -131,15 +131,16 @@ pub struct ShadowPolygon {
 /// the last.
 const PIECE: usize = 4096;
 
-/// The shadow polygons of one light sample for a count taken by `counting`.
+/// The shadow polygons of one light sample for a count taken by `counting`, each put
+/// through `camera` as soon as it is made: by pieces, in order.
 fn shadow_polygons(
     ctx: &ShadowContext,
     adjacency: &Adjacency,
     sample: LightSample,
     counting: Counting,
     far: Option<&FarPlane>,
-    counters: &mut Counters,
-) -> Vec<ShadowPolygon> {
+    camera: &Camera,
+) -> Vec<Piece> {
     let b = Builder::new(ctx, sample, counting, far);
     // With merged volumes, a closed solid's polygons turned away from the light are left out
     // (ours): every shadow ray crossing one has crossed, nearer the light, one of the same
@@ -149,66 +150,85 @@ fn shadow_polygons(
     let casts = |i: usize| !unseen[i];
     // Step 1: the merged sides, one per edge whose net weight is not zero. Each edge and
     // each polygon is decided on its own, so they are worked out in parallel, in order.
-    let mut out: Vec<ShadowPolygon> = adjacency
+    let mut pieces: Vec<Piece> = adjacency
         .edges
-        .par_iter()
-        .with_max_len(PIECE)
-        .filter_map(|e| {
-            let sharing = &adjacency.sharing[e.first as usize..(e.first + e.count) as usize];
-            if !sharing.iter().any(|s| casts(s.poly as usize)) {
-                return None; // no polygon on it casts: no side
+        .par_chunks(PIECE)
+        .map_init(Scratch::default, |scratch, edges| {
+            let mut piece = Piece::default();
+            for e in edges {
+                let sharing = &adjacency.sharing[e.first as usize..(e.first + e.count) as usize];
+                if !sharing.iter().any(|s| casts(s.poly as usize)) {
+                    continue; // no polygon on it casts: no side
+                }
+                let w = b.net_weight(e.a, e.b, sharing.iter().filter(|s| casts(s.poly as usize)));
+                if w != 0 {
+                    piece.weights[usize::from(w.abs() != 1)] += 1;
+                }
+                piece.add(camera, scratch, b.side(e.a, e.b, w, None));
             }
-            let w = b.net_weight(e.a, e.b, sharing.iter().filter(|s| casts(s.poly as usize)));
-            b.side(e.a, e.b, w, None)
+            piece
         })
         .collect();
-    let weight1 = out.iter().filter(|p| p.sign.abs() == 1).count() as u64;
-    let weight2 = out.len() as u64 - weight1;
     // Step 2: the caps of every merged polygon.
-    let caps = adjacency
-        .merged
-        .par_iter()
-        .with_max_len(PIECE)
-        .filter(|&&p| casts(p as usize))
-        .map_init(Projector::default, |proj, &p| b.caps(proj, ctx.scene.verts(p as usize), p as usize, None));
-    out.par_extend(caps.flat_map_iter(|c| c.into_iter().flatten()));
+    let caps = adjacency.merged.par_chunks(PIECE).map_init(
+        || (Scratch::default(), Projector::default()),
+        |(scratch, proj), polys| {
+            let mut piece = Piece::default();
+            for &p in polys.iter().filter(|&&p| casts(p as usize)) {
+                for cap in b.caps(proj, ctx.scene.verts(p as usize), p as usize, None) {
+                    piece.add(camera, scratch, cap);
+                }
+            }
+            piece
+        },
+    );
+    pieces.par_extend(caps);
     // Step 3: the volumes kept apart, each with its own sides and caps.
-    let mut proj = Projector::default();
-    for piece in adjacency.apart.iter().filter(|piece| casts(piece.poly as usize)) {
-        let owner = Some(ctx.scene.polygons[piece.poly as usize].face);
-        let v = &piece.verts;
+    let (mut piece, mut scratch, mut proj) = (Piece::default(), Scratch::default(), Projector::default());
+    for apart in adjacency.apart.iter().filter(|apart| casts(apart.poly as usize)) {
+        let owner = Some(ctx.scene.polygons[apart.poly as usize].face);
+        let v = &apart.verts;
         for k in 0..v.len() {
             let (a, c) = (v[k], v[(k + 1) % v.len()]);
-            out.extend(b.side(a, c, b.net_weight_one(a, c, piece.poly as usize), owner));
+            piece.add(camera, &mut scratch, b.side(a, c, b.net_weight_one(a, c, apart.poly as usize), owner));
         }
-        out.extend(b.caps(&mut proj, v, piece.poly as usize, owner).into_iter().flatten());
+        for cap in b.caps(&mut proj, v, apart.poly as usize, owner) {
+            piece.add(camera, &mut scratch, cap);
+        }
     }
-    counters.add("merged_edges", adjacency.edges.len() as u64);
-    counters.add("polygons_apart", adjacency.apart.len() as u64);
-    counters.add("sides_weight_1", weight1);
-    counters.add("sides_weight_2", weight2);
-    // Counted by part in one pass, in the order `Part` lists its parts.
-    let per_part = out
-        .par_iter()
-        .fold(
-            || [0u64; 5],
-            |mut n, p| {
-                n[p.part as usize] += 1;
-                n
-            },
-        )
-        .reduce(|| [0u64; 5], |a, b| std::array::from_fn(|k| a[k] + b[k]));
-    let names = [
-        "shadow_polygons_side",
-        "shadow_polygons_front_cap",
-        "shadow_polygons_back_cap",
-        "shadow_polygons_near_cap",
-        "shadow_polygons_far_cap",
-    ];
-    for (name, n) in names.into_iter().zip(per_part) {
-        counters.add(name, n);
+    pieces.push(piece);
+    pieces
+}
+
+/// The shadow polygons one piece made, as they came out of the camera, with their tally.
+#[derive(Default)]
+struct Piece {
+    /// The polygons on screen, in order.
+    polys: Vec<ScreenShadowPolygon>,
+    /// Their outlines, parallel to `polys`.
+    rings: Rings,
+    /// Every shadow polygon made, by part (in the order `Part` lists them).
+    made: [u64; 5],
+    /// The merged sides made of weight 1 and of weight 2 or more.
+    weights: [u64; 2],
+    /// The sides wholly outside the sight hull.
+    outside: u64,
+}
+
+impl Piece {
+    /// Puts `sp` (if one was made) through `camera` and keeps it if it is on screen.
+    fn add(&mut self, camera: &Camera, scratch: &mut Scratch, sp: Option<ShadowPolygon>) {
+        let Some(sp) = sp else { return };
+        self.made[sp.part as usize] += 1;
+        match scratch.screen(camera, &sp) {
+            Screened::On(poly) => {
+                self.polys.push(poly);
+                self.rings.push(&scratch.ring);
+            }
+            Screened::OutOfSight => self.outside += 1,
+            Screened::Off => {}
+        }
     }
-    out
 }
 
 /// Builds one light sample's shadow polygons.
@@ -709,7 +729,7 @@ pub struct ScreenVolumes {
     /// The polygons.
     pub polys: Vec<ScreenShadowPolygon>,
     /// Their screen outlines, parallel to `polys`.
-    pub rings: Vec<Vec<DVec2>>,
+    pub rings: Rings,
 }
 
 impl ScreenVolumes {
@@ -735,31 +755,34 @@ impl ScreenVolumes {
             }
             Counting::ZPass | Counting::NaiveZPass => (None, bounds.map(|b| SightHull::new(b, view.eye))),
         };
-        // Each shadow polygon is put through the camera on its own: in parallel, in order.
-        let screen: Vec<Screened> = shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), counters)
-            .into_par_iter()
-            .with_max_len(PIECE)
-            .map_init(Scratch::default, |scratch, sp| scratch.screen(view, hull.as_ref(), &sp))
-            .collect();
-        let (out, outside) = ScreenVolumes::on_screen(screen);
+        let camera = Camera { view, hull };
+        let pieces = shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), &camera);
+        let sum = |of: &dyn Fn(&Piece) -> u64| pieces.iter().map(of).sum::<u64>();
+        counters.add("merged_edges", adjacency.edges.len() as u64);
+        counters.add("polygons_apart", adjacency.apart.len() as u64);
+        counters.add("sides_weight_1", sum(&|p| p.weights[0]));
+        counters.add("sides_weight_2", sum(&|p| p.weights[1]));
+        let names = [
+            "shadow_polygons_side",
+            "shadow_polygons_front_cap",
+            "shadow_polygons_back_cap",
+            "shadow_polygons_near_cap",
+            "shadow_polygons_far_cap",
+        ];
+        for (k, name) in names.into_iter().enumerate() {
+            counters.add(name, sum(&|p| p.made[k]));
+        }
+        let outside = sum(&|p| p.outside);
+        let out = ScreenVolumes::joined(pieces);
         counters.add("screen_shadow_polygons", out.polys.len() as u64);
         counters.add("sides_outside_sight", outside);
         out
     }
 
-    /// The polygons of `screen` that are on screen, in order, moved out by pieces in
-    /// parallel: each piece counts its own, then fills its stretch of both lists. Also how
-    /// many sides were wholly out of sight.
-    fn on_screen(mut screen: Vec<Screened>) -> (ScreenVolumes, u64) {
-        let tally = |piece: &[Screened]| {
-            piece.iter().fold((0, 0), |(on, out), s| match s {
-                Screened::On(..) => (on + 1, out),
-                Screened::OutOfSight => (on, out + 1),
-                Screened::Off => (on, out),
-            })
-        };
-        let (counts, outside): (Vec<usize>, Vec<u64>) = screen.par_chunks(PIECE).map(tally).unzip();
-        let total = counts.iter().sum();
+    /// The pieces' polygons in one list, in order: each piece moves its own into its stretch,
+    /// in parallel.
+    fn joined(pieces: Vec<Piece>) -> ScreenVolumes {
+        let total = pieces.iter().map(|p| p.polys.len()).sum();
         let none = ScreenShadowPolygon {
             depth: DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
             sign: 0,
@@ -769,26 +792,24 @@ impl ScreenVolumes {
         };
         let mut polys = Vec::new();
         polys.par_extend(rayon::iter::repeat_n(none, total));
-        let mut rings = Vec::new();
-        rings.par_extend(rayon::iter::repeat_n(Vec::new(), total));
-        let pieces = stretches(&mut polys, counts.iter().copied()).into_par_iter().zip(stretches(&mut rings, counts));
-        screen.par_chunks_mut(PIECE).zip(pieces).for_each(|(piece, (polys, rings))| {
-            let on = piece.iter_mut().filter_map(|s| match std::mem::replace(s, Screened::Off) {
-                Screened::On(poly, ring) => Some((poly, ring)),
-                _ => None,
-            });
-            for ((p, r), (poly, ring)) in polys.iter_mut().zip(rings.iter_mut()).zip(on) {
-                (*p, *r) = (poly, ring);
-            }
-        });
-        (ScreenVolumes { polys, rings }, outside.iter().sum())
+        let stretched = stretches(&mut polys, pieces.iter().map(|p| p.polys.len()));
+        pieces.par_iter().zip(stretched).for_each(|(piece, polys)| polys.copy_from_slice(&piece.polys));
+        let rings: Vec<Rings> = pieces.into_iter().map(|p| p.rings).collect();
+        ScreenVolumes { polys, rings: Rings::joined(&rings) }
     }
+}
+
+/// Puts shadow polygons through the camera.
+struct Camera<'v> {
+    view: &'v crate::view::View,
+    /// The hull that sides are cut to first (none: not cut).
+    hull: Option<SightHull>,
 }
 
 /// What became of one shadow polygon put through the camera.
 enum Screened {
-    /// On screen: the polygon and its outline.
-    On(ScreenShadowPolygon, Vec<DVec2>),
+    /// On screen: the polygon (its outline is in the scratch's `ring`).
+    On(ScreenShadowPolygon),
     /// A side wholly outside the sight hull.
     OutOfSight,
     /// Edge-on to the eye, or wholly behind the near plane.
@@ -801,13 +822,16 @@ struct Scratch {
     cut: Vec<DVec4>,
     cut_scratch: Vec<DVec4>,
     clip: [Vec<DVec4>; 2],
+    /// The outline of the polygon last put on screen.
+    ring: Vec<DVec2>,
 }
 
 impl Scratch {
     /// Shadow polygon `sp` on screen: a side cut to `hull` first, then clipped to the near
     /// plane in homogeneous coordinates and projected.
-    fn screen(&mut self, view: &crate::view::View, hull: Option<&SightHull>, sp: &ShadowPolygon) -> Screened {
-        let verts = match hull {
+    fn screen(&mut self, camera: &Camera, sp: &ShadowPolygon) -> Screened {
+        let view = camera.view;
+        let verts = match &camera.hull {
             Some(hull) if sp.part == Part::Side => {
                 self.cut.clear();
                 self.cut.extend_from_slice(&sp.verts);
@@ -827,12 +851,12 @@ impl Scratch {
             },
             None => DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
         };
-        let mut ring = Vec::new();
         if sp.part == Part::NearCap {
             // On the near plane by construction: projected as it is (clipping it there
             // would let rounding throw it away).
-            ring.extend(sp.verts.iter().map(|&v| view.project(view.to_camera(v.truncate()))));
-        } else if !view.clip_project_homogeneous(verts, &mut self.clip, &mut ring) {
+            self.ring.clear();
+            self.ring.extend(sp.verts.iter().map(|&v| view.project(view.to_camera(v.truncate()))));
+        } else if !view.clip_project_homogeneous(verts, &mut self.clip, &mut self.ring) {
             return Screened::Off;
         }
         let poly = ScreenShadowPolygon {
@@ -842,7 +866,7 @@ impl Scratch {
             lies_on: sp.lies_on.unwrap_or(NONE),
             owner_face: sp.owner_face.unwrap_or(NONE),
         };
-        Screened::On(poly, ring)
+        Screened::On(poly)
     }
 }
 
