@@ -25,11 +25,14 @@ use rayon::prelude::*;
 use std::ops::Range;
 
 /// Lines per band, when the lines of a frame are shared among threads in bands: enough bands
-/// to keep every core busy, few enough that each band's setup (the active edges at its first
-/// line) stays small.
+/// to keep every core busy (four a thread or more), few enough that each band's setup (the
+/// active edges at its first line) stays small (64 lines or more a band, or 8 for small
+/// images), and as many bands for every thread: 17 bands of 64 lines on two threads would
+/// keep one thread a band longer than the other.
 pub fn band_height(height: u32) -> u32 {
-    let bands = (rayon::current_num_threads() as u32 * 4).max(1);
-    height.div_ceil(bands).clamp(8, 64)
+    let threads = (rayon::current_num_threads() as u32).max(1);
+    let bands = height.div_ceil(64).max(4 * threads).next_multiple_of(threads);
+    height.div_ceil(bands).max(8)
 }
 
 /// One non-horizontal edge, stored from its upper vertex.
@@ -741,6 +744,23 @@ impl OpenSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_thread_gets_as_many_bands_of_at_most_64_lines() {
+        for threads in 1..=4 {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            for height in [256, 480, 720, 1000, 1080, 1090, 2160, 4321] {
+                let band = pool.install(|| band_height(height));
+                let bands = height.div_ceil(band);
+                assert!((8..=64).contains(&band), "{threads} threads, {height} lines: {band}");
+                assert!(bands % threads as u32 == 0 && bands >= 4 * threads as u32, "{threads}, {height}: {bands}");
+            }
+            // A small image: bands of 8 lines at least.
+            assert_eq!(pool.install(|| band_height(20)), 8);
+        }
+        let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        assert_eq!(two.install(|| band_height(1080)), 60);
+    }
 
     #[test]
     fn a_large_table_built_and_sorted_by_several_threads_is_the_table_one_thread_builds() {
