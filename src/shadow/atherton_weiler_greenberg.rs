@@ -265,10 +265,11 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
                 sort.add(p, sort.keys[q as usize]);
             }
         }
-        // Inside: hidden where behind the front polygon; where in front, the sort was wrong.
+        // Inside and in front of the front polygon (what is behind it is hidden, and was
+        // dropped as it was cut): the sort was wrong there.
         let mut fronts = Vec::new();
-        for q in inside {
-            match relation(&q, &front) {
+        for (q, relation) in inside {
+            match relation {
                 Relation::Behind => {}
                 Relation::Front => fronts.push(q),
                 Relation::Mixed => fronts.extend(front_part(&q, &front, stats)?),
@@ -296,23 +297,28 @@ const PARALLEL_CUTS: usize = 16;
 /// at every front polygon.
 const CUTS_PER_PIECE: usize = 4;
 
-/// Each of `taken` cut by `front`'s outline ([`cut`]), in order: in parallel where there are
-/// many and Weiler and Atherton's clipper cuts them (a stack of polygons that all overlap
-/// one another); splits by edges are too quick to share out.
+/// A piece's parts inside the front polygon that are not wholly behind it (with how they
+/// lie), and its parts outside.
+type Sorted = (Vec<(Piece, Relation)>, Vec<Piece>);
+
+/// Each of `taken` cut by `front`'s outline ([`cut`]), in order, with the parts inside
+/// wholly behind `front` dropped (hidden): in parallel where there are many and Weiler and
+/// Atherton's clipper cuts them (a stack of polygons that all overlap one another); splits
+/// by edges are too quick to share out.
 fn cut_all(
     taken: Vec<(u32, Piece)>,
     front: &Piece,
     stats: &mut Pass1,
-) -> std::result::Result<Vec<(u32, Piece, Option<Parts>)>, ClipError> {
+) -> std::result::Result<Vec<(u32, Piece, Option<Sorted>)>, ClipError> {
     // Without splits, the sort hands over every piece whose box meets the front polygon's:
     // those apart from it are found here (in parallel, where the cuts are).
     let cut_unless_apart = |p: &Piece, st: &mut Pass1| {
         let apart = !st.convex_split && regions_apart(&p.region, &front.region);
-        if apart {
-            Ok(None)
-        } else {
-            cut(p, front, st)
-        }
+        let parts = if apart { None } else { cut(p, front, st)? };
+        Ok(parts.map(|(ins, outs)| {
+            let related = ins.into_iter().map(|q| (relation(&q, front), q));
+            (related.filter(|(r, _)| !matches!(r, Relation::Behind)).map(|(r, q)| (q, r)).collect(), outs)
+        }))
     };
     if taken.len() < PARALLEL_CUTS || stats.convex_split {
         return taken
@@ -324,7 +330,7 @@ fn cut_all(
             .collect();
     }
     let flags = Pass1 { convex_split: stats.convex_split, ..Default::default() };
-    let done: Vec<(u32, Piece, Option<Parts>, Pass1)> = taken
+    let done: Vec<(u32, Piece, Option<Sorted>, Pass1)> = taken
         .into_par_iter()
         .with_max_len(CUTS_PER_PIECE)
         .map(|(q, p)| {
