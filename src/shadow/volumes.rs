@@ -161,10 +161,11 @@ fn shadow_polygons(
                     continue; // no polygon on it casts: no side
                 }
                 let w = b.net_weight(e.a, e.b, sharing.iter().filter(|s| casts(s.poly as usize)));
-                if w != 0 {
+                let side = b.side(e.a, e.b, w, None);
+                if side.is_some() {
                     piece.weights[usize::from(w.abs() != 1)] += 1;
                 }
-                piece.add(camera, scratch, b.side(e.a, e.b, w, None));
+                piece.add(camera, scratch, side);
             }
             piece
         })
