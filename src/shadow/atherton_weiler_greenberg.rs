@@ -778,6 +778,7 @@ fn lit_in_view(
     let keep_cover = !lone.behind.is_empty();
     let done: Vec<(Vec<DetailPolygon>, Vec<Piece>, Pass1)> = lists
         .into_par_iter()
+        .with_max_len(1)
         .map(|(casters, others)| {
             let convex_split = stats.convex_split && !stacked(&casters, &others);
             let mut st = Pass1 { convex_split, backgrounds: stats.backgrounds, ..Default::default() };
