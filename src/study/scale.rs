@@ -291,6 +291,10 @@ fn trim(v: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
+/// The width of a plot, without its legend.
+#[cfg(feature = "plots")]
+const PLOT_WIDTH: u32 = 640;
+
 #[cfg(feature = "plots")]
 /// One plot: `y` of every method against what was rendered, on log axes (linear when the
 /// values span less than a decade, where a log axis would show no tick), with the spread as
@@ -307,7 +311,7 @@ struct Plot<'a, Y> {
 #[cfg(feature = "plots")]
 impl<Y: Fn(&Point) -> f64> super::plot::Chart for Plot<'_, Y> {
     fn size(&self) -> (u32, u32) {
-        (860, 480)
+        (PLOT_WIDTH + self.legend_width(), 480)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
@@ -325,7 +329,7 @@ impl<Y: Fn(&Point) -> f64> super::plot::Chart for Plot<'_, Y> {
             let (lo, hi) = range(p);
             (a.min(lo.max(f64::MIN_POSITIVE)), b.max(hi))
         });
-        let (plot_area, legend_area) = root.split_horizontally(640);
+        let (plot_area, legend_area) = root.split_horizontally(PLOT_WIDTH);
         let caption = format!("{label} against {x_label} ({} sweep)", o.sweep.name());
         let mut builder = ChartBuilder::on(&plot_area);
         builder.caption(caption, ("sans-serif", 17)).margin(14).x_label_area_size(44).y_label_area_size(64);
@@ -388,13 +392,25 @@ impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
         Ok(())
     }
 
+    /// The legend's entries: each method's name.
+    fn entries(&self) -> impl Iterator<Item = String> + '_ {
+        self.o.methods.iter().map(|(v, s)| format!("{v} + {s}"))
+    }
+
+    /// The legend's width: room for its longest entry (at most 8 pixels a character at the
+    /// legend's 13-pixel type, after the 36 pixels of the colour line), 220 pixels at least.
+    fn legend_width(&self) -> u32 {
+        let longest = self.entries().map(|e| e.chars().count()).max().unwrap_or(0) as u32;
+        (44 + 8 * longest).max(220)
+    }
+
     /// The methods' colours beside the plot.
     fn legend<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
-        for (i, (v, s)) in self.o.methods.iter().enumerate() {
+        for (i, entry) in self.entries().enumerate() {
             let colour = Palette99::pick(i).to_rgba();
             let row = 40 + 22 * i as i32;
             area.draw(&PathElement::new(vec![(8, row), (30, row)], colour.stroke_width(2))).err_text()?;
-            area.draw(&Text::new(format!("{v} + {s}"), (36, row - 7), ("sans-serif", 13))).err_text()?;
+            area.draw(&Text::new(entry, (36, row - 7), ("sans-serif", 13))).err_text()?;
         }
         if self.spread.is_some() {
             let row = 52 + 22 * self.o.methods.len() as i32;

@@ -184,6 +184,32 @@ fn scale_writes_csv_and_plots() {
 }
 
 #[test]
+fn the_scale_legend_holds_its_longest_method_name() {
+    use umbra::study::scale::{scale, ScaleOptions, Sweep};
+    let out = tmp("scale-legend");
+    let opts = ScaleOptions {
+        sweep: Sweep::Quads,
+        values: vec![1.0, 4.0],
+        methods: vec![(umbra::VisibilityMethod::Scanline, "atherton-weiler-greenberg".parse().unwrap())],
+        runs: 1,
+        width: 160,
+        height: 90,
+        count: 10,
+        size: 0.3,
+        counter: "visibility.depth_tests".into(),
+        out: out.clone(),
+    };
+    scale(&opts).unwrap();
+    let png = image::open(out.join("time.png")).unwrap().to_rgb8();
+    // The legend's one entry, "scanline + atherton-weiler-greenberg", is drawn near the top:
+    // its last dark pixel must stand clear of the image's right edge.
+    let (w, _) = png.dimensions();
+    let last_ink = (0..w).rev().find(|&x| (20..60).any(|y| png.get_pixel(x, y).0.iter().all(|&c| c < 128)));
+    let last_ink = last_ink.expect("the legend is drawn");
+    assert!(last_ink + 8 < w, "the legend's text runs to x = {last_ink} of {w}");
+}
+
+#[test]
 fn unknown_method_names_list_the_known_ones() {
     let e = "magic".parse::<ShadowMethod>().unwrap_err().to_string();
     for m in ShadowMethod::ALL {
