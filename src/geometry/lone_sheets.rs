@@ -19,6 +19,7 @@
 use super::weiler_atherton::signed_area;
 use super::{edge_loops, grid_cells, simple};
 use glam::DVec2;
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 /// No item (an edge with nothing across it).
@@ -53,24 +54,28 @@ pub(crate) fn find(items: &[Item]) -> Lone {
     let n = items.len();
     let mut lone = Lone { lone: vec![false; n], outlines: Vec::new() };
     let root = sheets(items);
-    // Each sheet's members, by root, and whether its boundary is one simple loop.
-    let mut members: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    // Each sheet's members, by root, and whether its boundary is one simple loop (the
+    // sheets in parallel).
+    let mut by_root: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     for i in (0..n).filter(|&i| root[i] != NO_ITEM) {
-        members.entry(root[i]).or_default().push(i as u32);
+        by_root.entry(root[i]).or_default().push(i as u32);
     }
-    let valid: FxHashMap<u32, bool> = members.iter().map(|(&r, m)| (r, clears_itself(items, &root, m))).collect();
+    let members: Vec<(u32, Vec<u32>)> = by_root.into_iter().collect();
+    let valid: FxHashMap<u32, bool> = members.par_iter().map(|(r, m)| (*r, clears_itself(items, &root, m))).collect();
     // The grid: each cell holds the one owner whose boxes meet it, or CONFLICT.
     let owner = |i: usize| if root[i] != NO_ITEM && valid[&root[i]] { root[i] } else { (n + i) as u32 };
     let Some(grid) = Grid::new(items, owner) else { return lone };
-    for (i, flag) in lone.lone.iter_mut().enumerate() {
-        *flag = root[i] != NO_ITEM && valid[&root[i]] && grid.only(items[i].bounds, root[i]);
-    }
-    for m in members.values() {
-        let rings = outline(items, &lone.lone, m);
-        if let Some(&first) = m.iter().find(|&&i| lone.lone[i as usize]) {
-            lone.outlines.push((first, rings));
-        }
-    }
+    lone.lone = (0..n)
+        .into_par_iter()
+        .map(|i| root[i] != NO_ITEM && valid[&root[i]] && grid.only(items[i].bounds, root[i]))
+        .collect();
+    lone.outlines = members
+        .par_iter()
+        .filter_map(|(_, m)| {
+            let first = *m.iter().find(|&&i| lone.lone[i as usize])?;
+            Some((first, outline(items, &lone.lone, m)))
+        })
+        .collect();
     lone
 }
 
@@ -81,7 +86,7 @@ fn sheets(items: &[Item]) -> Vec<u32> {
         let a = items[i].sheet.map_or(0.0, |(ring, _)| signed_area(ring));
         f64::from(a > 0.0) - f64::from(a < 0.0)
     };
-    let signs: Vec<f64> = (0..items.len()).map(sign).collect();
+    let signs: Vec<f64> = (0..items.len()).into_par_iter().map(sign).collect();
     let mut parent: Vec<u32> = (0..items.len() as u32).collect();
     fn up(parent: &mut [u32], mut i: u32) -> u32 {
         while parent[i as usize] != i {

@@ -825,26 +825,32 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
     let n = m.polys.len();
     let behind =
         if backgrounds && m.polys.iter().all(|p| p.casts) { wide_backgrounds(scene, m) } else { vec![false; n] };
-    let kept: Vec<usize> = (0..n).filter(|&i| !behind[i]).collect();
-    // The items across each whole caster's edges, by their places among the kept.
+    let kept: Vec<usize> = (0..n).into_par_iter().filter(|&i| !behind[i]).collect();
+    // The items across each whole caster's edges, by their places among the kept (a whole
+    // polygon is mapped once a view): worked out in parallel, in order.
     let sheet = |p: &MappedPolygon| p.casts && p.whole;
-    let local: FxHashMap<u32, u32> = kept
-        .iter()
-        .enumerate()
-        .filter(|(_, &i)| sheet(&m.polys[i]))
-        .map(|(k, &i)| (m.polys[i].source, k as u32))
-        .collect();
-    let mut across = Vec::new();
-    let mut first = Vec::with_capacity(kept.len());
-    for &i in &kept {
-        first.push(across.len());
-        if sheet(&m.polys[i]) {
-            let near = scene.across(m.polys[i].source as usize);
-            across.extend(near.iter().map(|q| local.get(q).copied().unwrap_or(NO_ITEM)));
-        }
+    let mut local = vec![NO_ITEM; scene.polygons.len()];
+    for (k, &i) in kept.iter().enumerate().filter(|(_, &i)| sheet(&m.polys[i])) {
+        local[m.polys[i].source as usize] = k as u32;
     }
-    let items: Vec<Item> = kept
+    let across: Vec<u32> = kept
+        .par_iter()
+        .map(|&i| &m.polys[i])
+        .filter(|p| sheet(p))
+        .flat_map_iter(|p| scene.across(p.source as usize).iter())
+        .map(|&q| local.get(q as usize).copied().unwrap_or(NO_ITEM))
+        .collect();
+    let edges_of = |&i: &usize| if sheet(&m.polys[i]) { m.polys[i].len as usize } else { 0 };
+    let first: Vec<usize> = kept
         .iter()
+        .scan(0, |at, i| {
+            let f = *at;
+            *at += edges_of(i);
+            Some(f)
+        })
+        .collect();
+    let items: Vec<Item> = kept
+        .par_iter()
         .zip(&first)
         .map(|(&i, &f)| {
             let p = &m.polys[i];
