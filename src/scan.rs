@@ -636,13 +636,13 @@ impl Chain<'_> {
 /// polygons cover the pixels reached, under the even-odd rule (each crossing of a tag's
 /// boundary toggles it). A tag opens at the first pixel right of a crossing and closes at the
 /// next. The open tags stay in the order they opened except where a closed one's slot was
-/// filled by the last. Toggling is O(1) in a dense set (each tag knows its slot: for tags
-/// numbered densely, a few per pixel line), or a search of the few open tags in a sparse one
-/// (for tags drawn from a large numbering, of which a line meets few).
+/// filled by the last. Toggling is O(1) in a dense set (each tag knows its slot), or a
+/// search of the open tags for a tag beyond its numbering.
 ///
-/// Watkins' visibility keeps the open tags as the span's covering set, the overlay walker
-/// turns open/close pairs into per-tag intervals, and Crow's walker into covered pieces of a
-/// run.
+/// Watkins' visibility keeps the open tags as the span's covering set (dense over a band's
+/// members), the overlay walker turns open/close pairs into per-tag intervals (dense over a
+/// receiver's polygons), and Crow's walker into covered pieces of a run (dense over the
+/// shadow polygons).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct OpenSet {
     /// `slot[tag]`: the tag's index in `tags` while open, else `CLOSED` (empty: sparse).
@@ -659,14 +659,19 @@ impl OpenSet {
         OpenSet { slot: vec![CLOSED; tags], tags: Vec::new(), starts: Vec::new() }
     }
 
-    /// Empties the set and makes it dense for tags `0..tags`, keeping its memory.
+    /// Empties the set and makes it dense for tags `0..tags` at least, keeping its memory
+    /// (it never shrinks: a set reset for many sizes in turn sets each slot once).
     pub(crate) fn reset(&mut self, tags: usize) {
         self.clear();
         // Every slot is closed after `clear`: only new ones need setting.
-        self.slot.resize(tags, CLOSED);
+        if self.slot.len() < tags {
+            self.slot.resize(tags, CLOSED);
+        }
     }
 
-    /// An empty sparse set, for any tags.
+    /// An empty sparse set, for any tags (a dense set takes the tags beyond its numbering
+    /// the same way).
+    #[cfg(test)]
     pub(crate) fn sparse() -> OpenSet {
         OpenSet::default()
     }

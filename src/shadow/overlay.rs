@@ -23,6 +23,9 @@ pub struct Overlay {
     tables: Vec<EdgeTable>,
     /// The tag of each table's first polygon: its edges are tagged from 0.
     base: Vec<u32>,
+    /// For each table, one past the greatest tag its edges carry: a walker keeps the open
+    /// polygons of a line in a dense set of that size.
+    tags: Vec<u32>,
     slot: FxHashMap<u32, Slot>,
     count: usize,
     rings: Vec<Vec<DVec2>>,
@@ -125,7 +128,9 @@ impl Overlay {
         if slot == self.tables.len() {
             self.tables.push(EdgeTable::new(self.height));
             self.base.push(tag);
+            self.tags.push(0);
         }
+        self.tags[slot] = self.tags[slot].max(tag - self.base[slot] + 1);
         for ring in rings {
             self.tables[slot].add_ring(tag - self.base[slot], ring);
             if self.keep_rings {
@@ -169,6 +174,7 @@ impl Overlay {
             t.finish();
             overlay.slot.insert(t.receiver, Slot::Table(overlay.tables.len() as u32));
             overlay.base.push(overlay.count as u32);
+            overlay.tags.push(t.count);
             overlay.count += t.count as usize;
             overlay.tables.push(t.table);
             overlay.rings.extend(t.rings);
@@ -211,7 +217,7 @@ impl Overlay {
             line: lines.start,
             active: (0..self.tables.len()).map(|_| None).collect(),
             lines: vec![LineIntervals::default(); self.tables.len()],
-            open: OpenSet::sparse(),
+            open: OpenSet::new(0),
         }
     }
 }
@@ -258,7 +264,8 @@ impl OverlayWalker<'_> {
         let cached = &mut self.lines[slot as usize];
         if cached.line != Some(line) {
             let aet = self.active[slot as usize].get_or_insert_with(|| ActiveEdges::new(table, line..end));
-            cached.pair(aet.advance_to(line), &mut self.open, self.overlay.base[slot as usize]);
+            let (base, tags) = (self.overlay.base[slot as usize], self.overlay.tags[slot as usize]);
+            cached.pair(aet.advance_to(line), &mut self.open, base, tags as usize);
             cached.line = Some(line);
         }
         // The intervals starting before the run's end, from the first whose reach passes
@@ -273,10 +280,12 @@ impl OverlayWalker<'_> {
 
 impl LineIntervals {
     /// Pairs a line's crossings (sorted by x) into each polygon's covered intervals, tagging
-    /// each with `base` plus its edges' tag.
-    fn pair(&mut self, crossings: &[crate::scan::Crossing], open: &mut OpenSet, base: u32) {
+    /// each with `base` plus its edges' tag (below `tags`).
+    fn pair(&mut self, crossings: &[crate::scan::Crossing], open: &mut OpenSet, base: u32, tags: usize) {
         self.all.clear();
-        open.clear();
+        // Dense: a receiver under a stack of casters has hundreds of polygons open at once
+        // (s4), and a sparse set searches them all at every crossing.
+        open.reset(tags);
         for c in crossings {
             let at = boundary(c.x, u32::MAX);
             if let Some(start) = open.toggle(c.tag, at) {
