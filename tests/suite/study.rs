@@ -138,26 +138,35 @@ fn trace_matches_a_hand_worked_line() {
     assert!(text.contains("8..10: [face 0 (1/z 1.0000 .. 1.0000), face 1 (1/z 0.5000 .. 0.5000)] -> face 0 nearest at both ends: wins"), "{text}");
 }
 
-#[test]
-fn scale_writes_csv_and_plots() {
-    use umbra::study::scale::{scale, ScaleOptions, Sweep};
-    let out = tmp("scale");
-    let opts = ScaleOptions {
-        sweep: Sweep::Quads,
-        values: vec![1.0, 4.0, 16.0],
-        methods: vec![
-            (umbra::VisibilityMethod::Scanline, ShadowMethod::None),
-            (umbra::VisibilityMethod::ZBuffer, ShadowMethod::None),
-        ],
+/// A small sweep of the quads family over `values` for `methods`, written into `out`.
+fn quads_sweep(
+    out: &std::path::Path,
+    values: Vec<f64>,
+    methods: Vec<(umbra::VisibilityMethod, ShadowMethod)>,
+) -> umbra::study::scale::ScaleOptions {
+    umbra::study::scale::ScaleOptions {
+        sweep: umbra::study::scale::Sweep::Quads,
+        values,
+        methods,
         runs: 1,
         width: 160,
         height: 90,
         count: 10,
         size: 0.3,
         counter: "visibility.depth_tests".into(),
-        out: out.clone(),
-    };
-    let points = scale(&opts).unwrap();
+        out: out.to_path_buf(),
+    }
+}
+
+#[test]
+fn scale_writes_csv_and_plots() {
+    use umbra::study::scale::scale;
+    let out = tmp("scale");
+    let methods = vec![
+        (umbra::VisibilityMethod::Scanline, ShadowMethod::None),
+        (umbra::VisibilityMethod::ZBuffer, ShadowMethod::None),
+    ];
+    let points = scale(&quads_sweep(&out, vec![1.0, 4.0, 16.0], methods)).unwrap();
     assert_eq!(points.len(), 6);
     // The z-buffer tests every covered pixel once per polygon: its depth tests grow with depth
     // complexity, about 160×90 per quad.
@@ -185,21 +194,9 @@ fn scale_writes_csv_and_plots() {
 
 #[test]
 fn the_scale_legend_holds_its_longest_method_name() {
-    use umbra::study::scale::{scale, ScaleOptions, Sweep};
     let out = tmp("scale-legend");
-    let opts = ScaleOptions {
-        sweep: Sweep::Quads,
-        values: vec![1.0, 4.0],
-        methods: vec![(umbra::VisibilityMethod::Scanline, "atherton-weiler-greenberg".parse().unwrap())],
-        runs: 1,
-        width: 160,
-        height: 90,
-        count: 10,
-        size: 0.3,
-        counter: "visibility.depth_tests".into(),
-        out: out.clone(),
-    };
-    scale(&opts).unwrap();
+    let methods = vec![(umbra::VisibilityMethod::Scanline, "atherton-weiler-greenberg".parse().unwrap())];
+    umbra::study::scale::scale(&quads_sweep(&out, vec![1.0, 4.0], methods)).unwrap();
     let png = image::open(out.join("time.png")).unwrap().to_rgb8();
     // The legend's one entry, "scanline + atherton-weiler-greenberg", is drawn near the top:
     // its last dark pixel must stand clear of the image's right edge.
