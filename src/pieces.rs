@@ -8,6 +8,8 @@
 //! fills its own stretch of one list ([`stretches`]); the list is the one a serial loop
 //! would make, with no pass that joins the pieces' lists on one thread.
 
+use rayon::prelude::*;
+
 /// `list` cut, from its start, into consecutive stretches of the given lengths (which sum
 /// to at most its length).
 pub(crate) fn stretches<T>(mut list: &mut [T], lengths: impl IntoIterator<Item = usize>) -> Vec<&mut [T]> {
@@ -18,6 +20,20 @@ pub(crate) fn stretches<T>(mut list: &mut [T], lengths: impl IntoIterator<Item =
         list = rest;
     }
     out
+}
+
+/// The `parts` one after another in one list, item `x` of part `k` written as `f(k, x)`:
+/// each part fills its own stretch, in parallel (the list a serial loop over the parts would
+/// make).
+pub(crate) fn joined<S: Sync, T: Copy + Send + Sync>(parts: &[&[S]], f: impl Fn(usize, &S) -> T + Sync) -> Vec<T> {
+    let lengths = || parts.iter().map(|p| p.len());
+    let Some(fill) = parts.iter().enumerate().find_map(|(k, p)| Some(f(k, p.first()?))) else { return Vec::new() };
+    let mut list = Vec::new();
+    list.par_extend(rayon::iter::repeat_n(fill, lengths().sum()));
+    stretches(&mut list, lengths()).into_par_iter().zip(parts).enumerate().for_each(|(k, (to, from))| {
+        to.iter_mut().zip(from.iter()).for_each(|(t, x)| *t = f(k, x));
+    });
+    list
 }
 
 #[cfg(test)]
@@ -31,5 +47,12 @@ mod tests {
         let lens: Vec<usize> = cut.iter().map(|s| s.len()).collect();
         assert_eq!(lens, [3, 0, 5]);
         assert_eq!((cut[0][0], cut[2][0], cut[2][4]), (0, 3, 7));
+    }
+
+    #[test]
+    fn parts_joined_follow_one_another() {
+        let parts: [&[u32]; 4] = [&[], &[1, 2], &[], &[3, 4, 5]];
+        assert_eq!(joined(&parts, |k, &x| 10 * k as u32 + x), [11, 12, 33, 34, 35]);
+        assert!(joined::<u32, u32>(&[&[], &[]], |_, &x| x).is_empty());
     }
 }

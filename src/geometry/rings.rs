@@ -6,9 +6,8 @@
 //! each ends: the parallel loops that make them fill one list a piece, and the pieces' lists
 //! are joined in parallel ([`Rings::joined`]).
 
-use crate::pieces::stretches;
+use crate::pieces::joined;
 use glam::DVec2;
-use rayon::prelude::*;
 
 /// A list of rings read by index: a list of lists or [`Rings`].
 pub(crate) trait RingList: Sync {
@@ -61,22 +60,16 @@ impl Rings {
     /// The rings of every part, in order, in one list: each part is copied into its own
     /// stretch of the list in parallel.
     pub fn joined(parts: &[Rings]) -> Rings {
-        let points_of = || parts.iter().map(|p| p.points.len());
-        let mut points = Vec::new();
-        points.par_extend(rayon::iter::repeat_n(DVec2::ZERO, points_of().sum()));
-        let mut ends = Vec::new();
-        ends.par_extend(rayon::iter::repeat_n(0, parts.iter().map(|p| p.count()).sum()));
-        let offsets = points_of().scan(0, |at, n| {
-            *at += n;
-            Some(*at - n)
-        });
-        let into =
-            stretches(&mut points, points_of()).into_iter().zip(stretches(&mut ends, parts.iter().map(|p| p.count())));
-        parts.par_iter().zip(into.zip(offsets).collect::<Vec<_>>()).for_each(|(part, ((points, ends), offset))| {
-            points.copy_from_slice(&part.points);
-            ends.iter_mut().zip(&part.ends).for_each(|(to, end)| *to = end + offset);
-        });
-        Rings { points, ends }
+        let offsets: Vec<usize> = parts
+            .iter()
+            .scan(0, |at, p| {
+                *at += p.points.len();
+                Some(*at - p.points.len())
+            })
+            .collect();
+        let points: Vec<&[DVec2]> = parts.iter().map(|p| p.points.as_slice()).collect();
+        let ends: Vec<&[usize]> = parts.iter().map(|p| p.ends.as_slice()).collect();
+        Rings { points: joined(&points, |_, &p| p), ends: joined(&ends, |k, &end| end + offsets[k]) }
     }
 }
 

@@ -270,7 +270,7 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
         let mut fronts = Vec::new();
         for (q, relation) in inside {
             match relation {
-                Relation::Behind => {}
+                Relation::Behind => {} // dropped in the cut already
                 Relation::Front => fronts.push(q),
                 Relation::Mixed => fronts.extend(front_part(&q, &front, stats)?),
             }
@@ -316,8 +316,11 @@ fn cut_all(
         let apart = !st.convex_split && regions_apart(&p.region, &front.region);
         let parts = if apart { None } else { cut(p, front, st)? };
         Ok(parts.map(|(ins, outs)| {
-            let related = ins.into_iter().map(|q| (relation(&q, front), q));
-            (related.filter(|(r, _)| !matches!(r, Relation::Behind)).map(|(r, q)| (q, r)).collect(), outs)
+            let not_behind = |q: Piece| match relation(&q, front) {
+                Relation::Behind => None,
+                r => Some((q, r)),
+            };
+            (ins.into_iter().filter_map(not_behind).collect(), outs)
         }))
     };
     if taken.len() < PARALLEL_CUTS || stats.convex_split {

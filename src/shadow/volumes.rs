@@ -50,7 +50,7 @@
 use super::projection::{light_side, unseen, Projector, Target};
 use super::ShadowContext;
 use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane, Rings};
-use crate::pieces::stretches;
+use crate::pieces::joined;
 use crate::pool::Stash;
 use crate::scene::LightSample;
 use crate::stats::Counters;
@@ -780,21 +780,11 @@ impl ScreenVolumes {
         out
     }
 
-    /// The pieces' polygons in one list, in order: each piece moves its own into its stretch,
-    /// in parallel.
+    /// The pieces' polygons in one list, in order: each piece copies its own into its
+    /// stretch, in parallel.
     fn joined(pieces: Vec<Piece>) -> ScreenVolumes {
-        let total = pieces.iter().map(|p| p.polys.len()).sum();
-        let none = ScreenShadowPolygon {
-            depth: DepthPlane { a: 0.0, b: 0.0, c: 0.0 },
-            sign: 0,
-            near_cap: false,
-            lies_on: NONE,
-            owner_face: NONE,
-        };
-        let mut polys = Vec::new();
-        polys.par_extend(rayon::iter::repeat_n(none, total));
-        let stretched = stretches(&mut polys, pieces.iter().map(|p| p.polys.len()));
-        pieces.par_iter().zip(stretched).for_each(|(piece, polys)| polys.copy_from_slice(&piece.polys));
+        let polys: Vec<&[ScreenShadowPolygon]> = pieces.iter().map(|p| p.polys.as_slice()).collect();
+        let polys = joined(&polys, |_, &p| p);
         let rings: Vec<Rings> = pieces.into_iter().map(|p| p.rings).collect();
         ScreenVolumes { polys, rings: Rings::joined(&rings) }
     }
