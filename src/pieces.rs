@@ -7,6 +7,8 @@
 //! each piece writes a list whose length only the piece knows, it counts first, and then
 //! fills its own stretch of one list ([`stretches`]); the list is the one a serial loop
 //! would make, with no pass that joins the pieces' lists on one thread.
+//! Where each piece has already made its own list, [`joined`] copies them into their
+//! stretches of one list, in parallel.
 
 use rayon::prelude::*;
 
