@@ -309,9 +309,11 @@ struct BenchArgs {
     /// Untimed frames first, per method.
     #[arg(long, default_value_t = 2)]
     warmup: usize,
-    /// Threads to render with (default: one per core).
-    #[arg(long)]
-    threads: Option<usize>,
+    /// Threads to render with (default: one per core). Several, comma-separated (`1,2`):
+    /// each method renders a frame at each count in turn, one row per count, and the rows
+    /// after the first count's give their speed-up over it.
+    #[arg(long, value_delimiter = ',')]
+    threads: Vec<usize>,
     /// One JSON object per row instead of a table.
     #[arg(long)]
     json: bool,
@@ -319,6 +321,11 @@ struct BenchArgs {
     /// stage (by default they are left out: they are never seen).
     #[arg(long)]
     no_back_face_cull: bool,
+    /// On a shared machine: before each row, wait until other processes leave the cores
+    /// idle, and time a row again (up to three tries) when they took a quarter of a core or
+    /// more while it ran. Every row reports the cores others used either way.
+    #[arg(long)]
+    undisturbed: bool,
     #[command(flatten)]
     shadow: ShadowArgs,
 }
@@ -642,17 +649,12 @@ fn bench_command(a: BenchArgs) -> umbra::Result<()> {
         warmup: a.warmup,
         runs: a.runs,
         back_face_cull: !a.no_back_face_cull,
+        undisturbed: a.undisturbed,
+        threads: a.threads,
     };
-    let threads = a.threads.unwrap_or(0);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::InvalidOption(format!("cannot start {threads} threads: {e}")))?;
-    let rows = pool.install(|| {
-        umbra::study::bench::bench(&scene, &opts, |what| {
-            use std::io::Write;
-            let _ = writeln!(std::io::stderr(), "bench: {what}");
-        })
+    let rows = umbra::study::bench::bench(&scene, &opts, |what| {
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), "bench: {what}");
     })?;
     if a.json {
         let mut text = String::new();

@@ -2,16 +2,20 @@
 //! be. The scene is loaded once; each method renders `warmup` frames that are not timed (page
 //! faults, caches, the shadow maps' storage), then `runs` timed frames in the same process.
 //! Each row gives the median, least and greatest time of the whole frame and of every phase
-//! the pipeline reports, and the process's peak resident memory so far.
+//! the pipeline reports, the process's peak resident memory so far, and how many cores other
+//! processes used meanwhile. Asked to (`undisturbed`), it waits for the other processes to leave
+//! the machine quiet before each row and times a row again when they did not, as the peers'
+//! harness in the benchmark suite does.
 
 use crate::error::{Error, Result};
 use crate::render::{RenderOptions, Rendered, Renderer};
 use crate::scene::Scene;
 use crate::shadow::ShadowMethod;
+use crate::study::quiet::{self, Monitor};
 use crate::visibility::VisibilityMethod;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// What to measure.
 #[derive(Debug, Clone)]
@@ -26,7 +30,28 @@ pub struct BenchOptions {
     pub runs: usize,
     /// See [`RenderOptions::back_face_cull`].
     pub back_face_cull: bool,
+    /// The thread counts to render with (none: as many as the caller's pool has). With
+    /// several, each method renders at each count in turn, an untimed frame then a timed
+    /// one, so that whatever else the machine does meanwhile falls on all of them alike; the
+    /// untimed frame keeps the switch of counts out of the times. Every row after the first
+    /// count's gives its speed-up over it.
+    pub threads: Vec<usize>,
+    /// Before each row, wait (at most five minutes) until other processes use under a tenth
+    /// of a core over two seconds; time a row again, up to three tries in all, when they
+    /// used a quarter of a core or more while it ran.
+    pub undisturbed: bool,
 }
+
+/// Foreign cores under which the machine counts as quiet, over [`QUIET_WINDOW`].
+const QUIET: f64 = 0.1;
+/// How long the machine must stay quiet.
+const QUIET_WINDOW: Duration = Duration::from_secs(2);
+/// How long to wait for a quiet machine before timing anyway.
+const QUIET_GIVE_UP: Duration = Duration::from_secs(300);
+/// Foreign cores during a row at which it was disturbed.
+const DISTURBED: f64 = 0.25;
+/// Tries per row, the first included.
+const TRIES: usize = 3;
 
 /// Median, least and greatest of a set of times, in milliseconds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -54,17 +79,27 @@ pub struct BenchRow {
     pub visibility: String,
     /// The shadow stage.
     pub shadows: String,
+    /// The threads it rendered with.
+    pub threads: usize,
     /// Timed frames.
     pub runs: usize,
     /// The whole frame, as the caller sees it (`render` called and returned).
     #[serde(flatten)]
     pub frame: Spread,
+    /// With several thread counts: the first count's frame over this one's, the median over
+    /// the runs of each run against the one rendered beside it.
+    pub speedup: Option<f64>,
     /// Each phase the pipeline reports (`view`, `visibility`, `shadow_prepare`, `shading`,
     /// `reflections` where mirrors are seen).
     pub phases: BTreeMap<String, Spread>,
     /// The process's peak resident memory after the row, in MB (0 where the system does
     /// not say).
     pub peak_rss_mb: f64,
+    /// The cores other processes used on average while the kept try ran, warm-up included
+    /// (`None` where the system does not say).
+    pub foreign_cores: Option<f64>,
+    /// How often the row was timed (more than once only when `undisturbed`).
+    pub tries: usize,
 }
 
 /// One method measured: its frame and phases over the timed runs, and the last run.
@@ -84,30 +119,50 @@ pub struct Measured {
 /// [`Renderer`], so that every frame after the first reuses the memory of the one before
 /// (the times are the algorithms', not the system's page faults).
 pub fn measure(scene: &Scene, opts: &RenderOptions, warmup: usize, runs: usize) -> Result<Measured> {
-    let mut renderer = Renderer::new();
-    for _ in 0..warmup {
-        renderer.render(scene, opts)?;
+    let mut timing = Timing::default();
+    for i in 0..warmup + runs.max(1) {
+        timing.frame(scene, opts, i >= warmup)?;
     }
-    let (mut times_ms, mut phases) = (Vec::new(), BTreeMap::<String, Vec<f64>>::new());
-    for _ in 0..runs.max(1) {
-        let t = Instant::now();
-        let out = renderer.render(scene, opts)?;
-        times_ms.push(t.elapsed().as_secs_f64() * 1e3);
-        for (k, ms) in out.stats.time_ms.iter().filter(|(k, _)| **k != "total") {
-            phases.entry(k.to_string()).or_default().push(*ms);
-        }
-    }
-    let last = renderer.into_rendered().ok_or_else(|| Error::Internal("no timed run".into()))?;
-    let phases = phases.into_iter().map(|(k, v)| (k, Spread::of(v))).collect();
-    Ok(Measured { frame: Spread::of(times_ms.clone()), times_ms, phases, last })
+    timing.finish()
 }
 
-/// Measures every visibility × shadow pair on `scene`; `progress` is told each row as it
-/// starts.
+/// One method's frames, rendered through one [`Renderer`] and timed.
+#[derive(Default)]
+struct Timing {
+    renderer: Renderer,
+    times_ms: Vec<f64>,
+    phases: BTreeMap<String, Vec<f64>>,
+}
+
+impl Timing {
+    /// Renders one frame, and records it when `timed`.
+    fn frame(&mut self, scene: &Scene, opts: &RenderOptions, timed: bool) -> Result<()> {
+        let t = Instant::now();
+        let out = self.renderer.render(scene, opts)?;
+        if timed {
+            self.times_ms.push(t.elapsed().as_secs_f64() * 1e3);
+            for (k, ms) in out.stats.time_ms.iter().filter(|(k, _)| **k != "total") {
+                self.phases.entry(k.to_string()).or_default().push(*ms);
+            }
+        }
+        Ok(())
+    }
+
+    /// The spreads of the timed frames, and the last frame.
+    fn finish(self) -> Result<Measured> {
+        let last = self.renderer.into_rendered().ok_or_else(|| Error::Internal("no timed run".into()))?;
+        let phases = self.phases.into_iter().map(|(k, v)| (k, Spread::of(v))).collect();
+        Ok(Measured { frame: Spread::of(self.times_ms.clone()), times_ms: self.times_ms, phases, last })
+    }
+}
+
+/// Measures every visibility × shadow pair on `scene`, at each thread count; `progress` is
+/// told each row as it starts.
 pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<Vec<BenchRow>> {
     if o.runs == 0 {
         return Err(Error::InvalidOption("bench needs at least one timed run".into()));
     }
+    let pools = pools(&o.threads)?;
     let mut rows = Vec::new();
     for &v in &o.visibility {
         for s in &o.shadows {
@@ -118,18 +173,87 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
                 back_face_cull: o.back_face_cull,
                 ..RenderOptions::default()
             };
-            let m = measure(scene, &opts, o.warmup, o.runs)?;
-            rows.push(BenchRow {
-                visibility: v.name().into(),
-                shadows: s.name().into(),
-                runs: o.runs,
-                frame: m.frame,
-                phases: m.phases,
-                peak_rss_mb: peak_rss_mb(),
-            });
+            let (each, foreign_cores, tries) = measure_undisturbed(scene, &opts, o, &pools, &mut progress)?;
+            let first = each[0].times_ms.clone();
+            for (m, pool) in each.into_iter().zip(&pools) {
+                let speedup = (pools.len() > 1).then(|| paired_ratio(&first, &m.times_ms));
+                rows.push(BenchRow {
+                    visibility: v.name().into(),
+                    shadows: s.name().into(),
+                    threads: pool.current_num_threads(),
+                    runs: o.runs,
+                    frame: m.frame,
+                    speedup,
+                    phases: m.phases,
+                    peak_rss_mb: peak_rss_mb(),
+                    foreign_cores,
+                    tries,
+                });
+            }
         }
     }
     Ok(rows)
+}
+
+/// A pool per thread count, or one of the caller's size where none is given.
+fn pools(threads: &[usize]) -> Result<Vec<rayon::ThreadPool>> {
+    if threads.contains(&0) {
+        return Err(Error::InvalidOption("bench cannot render with 0 threads".into()));
+    }
+    let counts = if threads.is_empty() { vec![rayon::current_num_threads()] } else { threads.to_vec() };
+    counts
+        .into_iter()
+        .map(|n| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| Error::InvalidOption(format!("cannot start {n} threads: {e}")))
+        })
+        .collect()
+}
+
+/// The median over runs of `first[i] / other[i]`: how many times faster `other` ran than
+/// `first`, each run against the one beside it in time.
+fn paired_ratio(first: &[f64], other: &[f64]) -> f64 {
+    let ratios: Vec<f64> = first.iter().zip(other).map(|(a, b)| a / b.max(1e-9)).collect();
+    Spread::of(ratios).median_ms
+}
+
+/// One method measured at every pool's thread count, in turn frame by frame (warm-up frames
+/// first), and the foreign cores and tries of the kept try: once, or as
+/// [`BenchOptions::undisturbed`] says.
+fn measure_undisturbed(
+    scene: &Scene,
+    opts: &RenderOptions,
+    o: &BenchOptions,
+    pools: &[rayon::ThreadPool],
+    progress: &mut impl FnMut(&str),
+) -> Result<(Vec<Measured>, Option<f64>, usize)> {
+    let mut tries = 0;
+    loop {
+        tries += 1;
+        if o.undisturbed && !quiet::wait(QUIET, QUIET_WINDOW, QUIET_GIVE_UP) {
+            progress("the machine did not go quiet in five minutes; timing anyway");
+        }
+        let monitor = Monitor::start();
+        let mut timings: Vec<Timing> = pools.iter().map(|_| Timing::default()).collect();
+        for i in 0..o.warmup + o.runs {
+            let timed = i >= o.warmup;
+            // Where the count changes before each frame, an untimed frame first settles the
+            // new count's threads, cores and caches, as a run of frames at one count would.
+            let settle = usize::from(timed && pools.len() > 1);
+            for (timing, pool) in timings.iter_mut().zip(pools) {
+                pool.install(|| (0..settle).try_for_each(|_| timing.frame(scene, opts, false)))?;
+                pool.install(|| timing.frame(scene, opts, timed))?;
+            }
+        }
+        let foreign = monitor.foreign();
+        let each = timings.into_iter().map(Timing::finish).collect::<Result<Vec<_>>>()?;
+        if !o.undisturbed || !foreign.is_some_and(|f| f >= DISTURBED) || tries == TRIES {
+            return Ok((each, foreign, tries));
+        }
+        progress(&format!("others used {:.2} cores meanwhile; timing again", foreign.unwrap_or(0.0)));
+    }
 }
 
 /// The peak resident set of this process in MB (`VmHWM` in `/proc/self/status`; 0 where
@@ -144,7 +268,8 @@ fn peak_rss_mb() -> f64 {
 }
 
 /// The rows as a readable table: one line per method, the frame and each phase as
-/// `median (min–max)`.
+/// `median (min–max)`, then the peak memory, the threads, the speed-up over the first thread
+/// count and the cores others used.
 pub fn table(rows: &[BenchRow]) -> String {
     // The phases in the pipeline's order, then any others by name.
     const ORDER: [&str; 6] = ["view", "visibility", "shadow_prepare", "shadow_walk", "shading", "reflections"];
@@ -156,13 +281,15 @@ pub fn table(rows: &[BenchRow]) -> String {
     for p in &phases {
         out += &format!(" {:>22}", p);
     }
-    out += &format!(" {:>9}\n", "peak MB");
+    out += &format!(" {:>9} {:>7} {:>8} {:>6}\n", "peak MB", "threads", "speed-up", "others");
     for r in rows {
         out += &format!("{:<10} {:<26} {:>24}", r.visibility, r.shadows, cell(&r.frame));
         for p in &phases {
             out += &format!(" {:>22}", r.phases.get(*p).map_or_else(|| "-".to_string(), cell));
         }
-        out += &format!(" {:>9.0}\n", r.peak_rss_mb);
+        let others = r.foreign_cores.map_or_else(|| "-".to_string(), |f| format!("{f:.2}"));
+        let speedup = r.speedup.map_or_else(|| "-".to_string(), |x| format!("{x:.2}"));
+        out += &format!(" {:>9.0} {:>7} {:>8} {:>6}\n", r.peak_rss_mb, r.threads, speedup, others);
     }
     out
 }

@@ -10,6 +10,7 @@ pub mod compare;
 pub mod explore;
 #[cfg(feature = "plots")]
 mod plot;
+mod quiet;
 pub mod scale;
 pub mod trace;
 

@@ -199,8 +199,8 @@ fn work_beyond_the_memory_budget_is_refused_before_it_starts() {
 }
 
 /// `bench` times each visibility × shadow pair with warm-up in one process and reports the
-/// frame's and each phase's median, least and greatest time and the peak memory, as one JSON
-/// object per row.
+/// frame's and each phase's median, least and greatest time, the peak memory, the threads and
+/// the cores other processes used meanwhile, as one JSON object per row.
 #[test]
 fn bench_reports_spread_phases_and_memory() {
     let out = umbra()
@@ -221,10 +221,44 @@ fn bench_reports_spread_phases_and_memory() {
         }
         assert!(r["peak_rss_mb"].as_f64().unwrap() > 1.0, "{r}");
         assert_eq!(r["runs"], 3);
+        assert_eq!(r["threads"], 2);
+        assert_eq!(r["tries"], 1, "timed once unless asked to wait for a quiet machine");
+        if cfg!(target_os = "linux") {
+            assert!(r["foreign_cores"].as_f64().is_some_and(|f| f >= 0.0), "{r}");
+        }
     }
     assert_eq!(rows[3]["visibility"], "zbuffer");
     assert_eq!(rows[3]["shadows"], "crow");
+    assert!(rows.iter().all(|r| r["speedup"].is_null()), "one thread count, no speed-up");
     refused(&["bench", SMALL, "--runs", "0"], "at least one timed run");
+    refused(&["bench", SMALL, "--threads", "1,0"], "0 threads");
+}
+
+/// `bench --threads 1,2` renders each method at one and two threads in turn, one row per
+/// count, and gives the two-thread row's speed-up over the one-thread row.
+#[test]
+fn bench_compares_thread_counts_frame_by_frame() {
+    let out = umbra()
+        .args(["bench", SMALL, "--shadows", "none,crow", "--runs", "3", "--warmup", "1", "--threads", "1,2", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows: Vec<serde_json::Value> =
+        String::from_utf8_lossy(&out.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let seen: Vec<(&str, u64)> =
+        rows.iter().map(|r| (r["shadows"].as_str().unwrap(), r["threads"].as_u64().unwrap())).collect();
+    assert_eq!(seen, [("none", 1), ("none", 2), ("crow", 1), ("crow", 2)]);
+    for pair in rows.chunks(2) {
+        assert_eq!(pair[0]["speedup"], 1.0, "the first count against itself");
+        let (one, two) = (pair[0]["median_ms"].as_f64().unwrap(), pair[1]["median_ms"].as_f64().unwrap());
+        let speedup = pair[1]["speedup"].as_f64().unwrap();
+        // The median of per-run ratios lies between the extreme runs' ratios.
+        let (lo, hi) = (
+            pair[0]["min_ms"].as_f64().unwrap() / pair[1]["max_ms"].as_f64().unwrap(),
+            pair[0]["max_ms"].as_f64().unwrap() / pair[1]["min_ms"].as_f64().unwrap(),
+        );
+        assert!(lo <= speedup && speedup <= hi, "{speedup} outside {lo}..{hi} ({one} ms / {two} ms)");
+    }
 }
 
 /// Commands that write files say what they wrote and refuse to overwrite without `--force`;
