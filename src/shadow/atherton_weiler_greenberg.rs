@@ -31,6 +31,7 @@ use crate::geometry::convex_split::{self, is_convex};
 use crate::geometry::lone_sheets::{self, Item, NO_ITEM};
 use crate::geometry::weiler_atherton::{clip, regions_apart, ring_bounds, signed_area, ClipError, Region, Ring};
 use crate::geometry::{clip_in_place, clip_polygon, even_odd, grid_cells, Plane};
+use crate::pieces;
 use crate::scene::{LightSample, ObjText, Scene};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -624,6 +625,39 @@ impl LightView {
     }
 }
 
+/// Per polygon of `scene` (for a point light sample; empty for others): the one face of the
+/// light's cube, numbered as [`LightView::views`] gives them, that holds all its corners
+/// inside its open frustum, or `None` where there is no such face. Such a polygon is in no
+/// other face's frustum (ours, to spare each face the frustum tests of the polygons that lie
+/// in another). `unseen` polygons are left as `None`.
+fn cube_faces(scene: &Scene, sample: LightSample, unseen: &[bool]) -> Vec<Option<u8>> {
+    let LightSample::Point(light) = sample else { return Vec::new() };
+    (0..scene.polygons.len())
+        .into_par_iter()
+        .map(|i| {
+            let mut corners = scene.verts(i).iter().map(|&v| cube_face(v - light));
+            let first = corners.next().flatten();
+            (!unseen[i] && corners.all(|f| f == first)).then_some(first).flatten()
+        })
+        .collect()
+}
+
+/// The cube face (numbered as in [`LightView::views`]) whose open frustum holds `p`, a point
+/// relative to the light: the axis along which `p` reaches farthest, if it is the only one.
+fn cube_face(p: DVec3) -> Option<u8> {
+    let a = p.abs();
+    let axis = if a.x > a.y && a.x > a.z {
+        0
+    } else if a.y > a.x && a.y > a.z {
+        1
+    } else if a.z > a.x && a.z > a.y {
+        2
+    } else {
+        return None;
+    };
+    Some(2 * axis as u8 + u8::from(p[axis] < 0.0))
+}
+
 /// A polygon's region for the clipper, whose rings must not cross themselves: a
 /// self-intersecting outline (`crossing`; inside by the even-odd rule) becomes the
 /// trapezoids of its even-odd region ([`crate::geometry::even_odd`]), which touch but never
@@ -652,6 +686,9 @@ struct Mapped {
     polys: Vec<MappedPolygon>,
 }
 
+/// Polygons a task of [`Mapped::new`] maps.
+const MAP_PIECE: usize = 4096;
+
 /// One polygon of a [`Mapped`] view.
 #[derive(Debug, Clone, Copy)]
 struct MappedPolygon {
@@ -670,33 +707,35 @@ struct MappedPolygon {
 }
 
 impl Mapped {
-    /// The polygons of `scene` that `view` may see (`unseen` left out), mapped in parallel,
-    /// in order.
-    fn new(scene: &Scene, unseen: &[bool], view: LightView, extent: f64) -> Mapped {
-        let parts: Vec<Mapped> = (0..scene.polygons.len())
+    /// The polygons of `scene` that `view` may see (those `unseen` left out), mapped in
+    /// parallel, in order.
+    fn new(scene: &Scene, unseen: impl Fn(usize) -> bool + Sync, view: LightView, extent: f64) -> Mapped {
+        let n = scene.polygons.len();
+        let parts: Vec<Mapped> = (0..n.div_ceil(MAP_PIECE))
             .into_par_iter()
-            .with_min_len(1024)
-            .fold(
-                || (Mapped::default(), [Vec::new(), Vec::new()]),
-                |(mut m, mut scratch), i| {
-                    if !unseen[i] {
-                        m.push(scene, view, i, 1e-9 * extent, &mut scratch);
-                    }
-                    (m, scratch)
-                },
-            )
-            .map(|(m, _)| m)
+            .map(|k| {
+                let (mut m, mut scratch) = (Mapped::default(), [Vec::new(), Vec::new()]);
+                for i in (k * MAP_PIECE..n.min((k + 1) * MAP_PIECE)).filter(|&i| !unseen(i)) {
+                    m.push(scene, view, i, 1e-9 * extent, &mut scratch);
+                }
+                m
+            })
             .collect();
-        let mut all = Mapped {
-            points: Vec::with_capacity(parts.iter().map(|m| m.points.len()).sum()),
-            polys: Vec::with_capacity(parts.iter().map(|m| m.polys.len()).sum()),
-        };
-        for part in parts {
-            let base = all.points.len() as u32;
-            all.points.extend(part.points);
-            all.polys.extend(part.polys.into_iter().map(|p| MappedPolygon { first: p.first + base, ..p }));
+        // Each part's outlines start where the parts before it end.
+        let base: Vec<u32> = parts
+            .iter()
+            .scan(0, |at, m| {
+                let b = *at;
+                *at += m.points.len() as u32;
+                Some(b)
+            })
+            .collect();
+        let points: Vec<&[DVec2]> = parts.iter().map(|m| &m.points[..]).collect();
+        let polys: Vec<&[MappedPolygon]> = parts.iter().map(|m| &m.polys[..]).collect();
+        Mapped {
+            points: pieces::joined(&points, |_, &p| p),
+            polys: pieces::joined(&polys, |k, &p| MappedPolygon { first: p.first + base[k], ..p }),
         }
-        all
     }
 
     /// Maps polygon `i` of `scene`, if the view sees any of it.
@@ -747,7 +786,7 @@ impl Mapped {
 /// the casters sorted, the lit fragments of every polygon taken back into world space.
 fn lit_in_view(
     scene: &Scene,
-    unseen: &[bool],
+    unseen: impl Fn(usize) -> bool + Sync,
     view: LightView,
     extent: f64,
     stats: &mut Pass1,
@@ -1166,11 +1205,15 @@ impl ShadowDatabase {
         let mut done: Vec<(usize, Vec<DetailPolygon>, Pass1)> = Vec::new();
         for (s, sample) in l.samples().into_iter().enumerate() {
             let unseen = unseen(scene, sample, extent, true);
+            let face = cube_faces(scene, sample, &unseen);
             let views: Vec<(Vec<DetailPolygon>, Pass1)> = LightView::views(sample)
                 .into_par_iter()
-                .map(|view| {
+                .enumerate()
+                .map(|(f, view)| {
                     let mut stats = Pass1::new(options);
-                    let lit = lit_in_view(scene, &unseen, view, extent, &mut stats).map_err(clip_error)?;
+                    // A polygon wholly inside one cube face is mapped into that face alone.
+                    let unseen = |i: usize| unseen[i] || face.get(i).is_some_and(|g| g.is_some_and(|g| g != f as u8));
+                    let lit = lit_in_view(scene, unseen, view, extent, &mut stats).map_err(clip_error)?;
                     Ok((lit, stats))
                 })
                 .collect::<Result<_>>()?;
@@ -1304,5 +1347,61 @@ impl ShadowStage for AthertonWeilerGreenberg<'_> {
 
     fn outlines(&self) -> Vec<Vec<DVec2>> {
         self.detail.first().map_or_else(Vec::new, |o| o.rings().to_vec())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::newell_normal;
+    use rand::{Rng, SeedableRng};
+
+    /// A polygon that [`cube_faces`] puts in one cube face maps into no other: for random
+    /// triangles around a light, many with corners on or a hair off the faces' borders (where
+    /// two or three coordinates are equal in size), every face but the chosen one finds
+    /// nothing of it, so leaving it out of those faces changes nothing.
+    #[test]
+    fn a_polygon_in_one_cube_face_maps_into_no_other() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1978);
+        let light = DVec3::new(0.25, -0.5, 2.0);
+        let views = LightView::views(LightSample::Point(light));
+        let (mut alone, mut several) = (0, 0);
+        for _ in 0..20_000 {
+            // Corners near one another, and near a border: a random point with one
+            // coordinate's size copied onto another, then nudged by 0, 1 or a few units in
+            // the last place.
+            let c = DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
+            let (a, b) = (rng.gen_range(0..3), rng.gen_range(0..3));
+            let mut corner = || {
+                let mut p =
+                    c + DVec3::new(rng.gen_range(-0.1..0.1), rng.gen_range(-0.1..0.1), rng.gen_range(-0.1..0.1));
+                if rng.gen_bool(0.5) {
+                    let sign = if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
+                    p[b] = sign * p[a].abs();
+                    let nudge = [0u64, 1, 3][rng.gen_range(0..3)];
+                    p[b] = f64::from_bits(p[b].to_bits().wrapping_add(nudge));
+                }
+                light + p
+            };
+            let verts = [corner(), corner(), corner()];
+            let n = newell_normal(&verts);
+            if n.length() < 1e-12 {
+                continue;
+            }
+            let plane = Plane::new(n.normalize(), verts[0]);
+            let first = verts.iter().map(|&v| cube_face(v - light)).next().flatten();
+            let face = (verts.iter().all(|&v| cube_face(v - light) == first)).then_some(first).flatten();
+            let Some(face) = face else {
+                several += 1;
+                continue;
+            };
+            alone += 1;
+            for (g, view) in views.iter().enumerate().filter(|&(g, _)| g != face as usize) {
+                let mut out = Vec::new();
+                let got = view.map_into(&verts, &plane, 1e-9, &mut out, &mut [Vec::new(), Vec::new()]);
+                assert!(got.is_none() && out.is_empty(), "{verts:?} in face {face} maps into face {g}");
+            }
+        }
+        assert!(alone > 1000 && several > 1000, "{alone} in one face, {several} not");
     }
 }
