@@ -12,7 +12,6 @@ use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::visibility::Run;
 use glam::DVec2;
 use rayon::prelude::*;
-use rustc_hash::FxHashMap;
 use std::ops::Range;
 
 /// A set of screen polygons, each lying on a receiver polygon.
@@ -26,7 +25,9 @@ pub struct Overlay {
     /// For each table, one past the greatest tag its edges carry: a walker keeps the open
     /// polygons of a line in a dense set of that size.
     tags: Vec<u32>,
-    slot: FxHashMap<u32, Slot>,
+    /// What it holds for each receiver, by the receiver's index (as far as the greatest
+    /// receiver it holds).
+    slot: Vec<Option<Slot>>,
     count: usize,
     rings: Vec<Vec<DVec2>>,
     keep_rings: bool,
@@ -122,9 +123,14 @@ impl Overlay {
     /// Adds a polygon with several rings (holes, by the even-odd rule) lying on `receiver`.
     pub fn add_rings(&mut self, receiver: u32, rings: &[Vec<DVec2>]) -> u32 {
         let tag = self.count as u32;
-        let next = Slot::Table(self.tables.len() as u32);
-        let Slot::Table(slot) = *self.slot.entry(receiver).or_insert(next) else { return tag };
-        let slot = slot as usize;
+        let slot = match self.slot(receiver) {
+            Some(Slot::Whole(_)) => return tag,
+            Some(Slot::Table(slot)) => slot as usize,
+            None => {
+                self.set_slot(receiver, Slot::Table(self.tables.len() as u32));
+                self.tables.len()
+            }
+        };
         if slot == self.tables.len() {
             self.tables.push(EdgeTable::new(self.height));
             self.base.push(tag);
@@ -172,7 +178,7 @@ impl Overlay {
         let mut overlay = Overlay::new(height, keep_rings);
         for mut t in tables.into_iter().filter(|t| t.count > 0) {
             t.finish();
-            overlay.slot.insert(t.receiver, Slot::Table(overlay.tables.len() as u32));
+            overlay.set_slot(t.receiver, Slot::Table(overlay.tables.len() as u32));
             overlay.base.push(overlay.count as u32);
             overlay.tags.push(t.count);
             overlay.count += t.count as usize;
@@ -187,9 +193,23 @@ impl Overlay {
     /// with no edges to walk. It takes the place of any polygons added on it before.
     pub fn add_wholes(&mut self, receivers: &[u32]) {
         for &r in receivers {
-            self.slot.insert(r, Slot::Whole(self.count as u32));
+            self.set_slot(r, Slot::Whole(self.count as u32));
             self.count += 1;
         }
+    }
+
+    /// What the overlay holds for `receiver`.
+    fn slot(&self, receiver: u32) -> Option<Slot> {
+        self.slot.get(receiver as usize).copied().flatten()
+    }
+
+    /// Sets what the overlay holds for `receiver`.
+    fn set_slot(&mut self, receiver: u32, slot: Slot) {
+        let r = receiver as usize;
+        if r >= self.slot.len() {
+            self.slot.resize((r + 1).max(2 * self.slot.len()), None);
+        }
+        self.slot[r] = Some(slot);
     }
 
     /// Sorts the edge tables; call once after the last `add`.
@@ -254,10 +274,10 @@ impl OverlayWalker<'_> {
     /// `receiver` cover pixels of `x0..x1` (clipped to it), ordered by where they start.
     pub fn intervals(&mut self, receiver: u32, x0: u32, x1: u32, out: &mut Vec<Interval>) {
         out.clear();
-        let slot = match self.overlay.slot.get(&receiver) {
+        let slot = match self.overlay.slot(receiver) {
             None => return,
-            Some(&Slot::Whole(tag)) => return out.push(Interval { start: x0, end: x1, tag }),
-            Some(&Slot::Table(slot)) => slot,
+            Some(Slot::Whole(tag)) => return out.push(Interval { start: x0, end: x1, tag }),
+            Some(Slot::Table(slot)) => slot,
         };
         let table = &self.overlay.tables[slot as usize];
         let (line, end) = (self.line, self.end);
