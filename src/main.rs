@@ -322,8 +322,10 @@ struct BenchArgs {
     #[arg(long)]
     no_back_face_cull: bool,
     /// On a shared machine: before each row, wait until other processes leave the cores
-    /// idle, and time a row again (up to three tries) when they took a quarter of a core or
-    /// more while it ran. Every row reports the cores others used either way.
+    /// idle and all cores run a fixed loop at once as fast as one alone; time a row again
+    /// (up to three tries) when others took a quarter of a core or more while it ran, or the
+    /// cores ran 15% slower together than alone right after it. Every row reports the cores
+    /// others used either way.
     #[arg(long)]
     undisturbed: bool,
     #[command(flatten)]

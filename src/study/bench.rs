@@ -37,8 +37,9 @@ pub struct BenchOptions {
     /// count's gives its speed-up over it.
     pub threads: Vec<usize>,
     /// Before each row, wait (at most five minutes) until other processes use under a tenth
-    /// of a core over two seconds; time a row again, up to three tries in all, when they
-    /// used a quarter of a core or more while it ran.
+    /// of a core over two seconds and all cores run a fixed loop at once within 15% of one
+    /// core alone; time a row again, up to three tries in all, when others used a quarter of
+    /// a core or more while it ran, or the cores ran 15% slower together right after it.
     pub undisturbed: bool,
 }
 
@@ -50,6 +51,9 @@ const QUIET_WINDOW: Duration = Duration::from_secs(2);
 const QUIET_GIVE_UP: Duration = Duration::from_secs(300);
 /// Foreign cores during a row at which it was disturbed.
 const DISTURBED: f64 = 0.25;
+/// How much slower all cores at once may run a fixed loop than one alone
+/// ([`quiet::core_contention`]) before the machine counts as disturbed.
+const CONTENDED: f64 = 1.15;
 /// Tries per row, the first included.
 const TRIES: usize = 3;
 
@@ -95,9 +99,20 @@ pub struct BenchRow {
     /// The process's peak resident memory after the row, in MB (0 where the system does
     /// not say).
     pub peak_rss_mb: f64,
+    /// What else the machine did while the row ran.
+    #[serde(flatten)]
+    pub disturbance: Disturbance,
+}
+
+/// What else the machine did while a row ran.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Disturbance {
     /// The cores other processes used on average while the kept try ran, warm-up included
     /// (`None` where the system does not say).
     pub foreign_cores: Option<f64>,
+    /// With `undisturbed`, right after the kept try: how much slower the slowest core ran a
+    /// fixed loop with all cores at once than one core alone (about 1 when all are free).
+    pub contention: Option<f64>,
     /// How often the row was timed (more than once only when `undisturbed`).
     pub tries: usize,
 }
@@ -173,7 +188,7 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
                 back_face_cull: o.back_face_cull,
                 ..RenderOptions::default()
             };
-            let (each, foreign_cores, tries) = measure_undisturbed(scene, &opts, o, &pools, &mut progress)?;
+            let (each, disturbance) = measure_undisturbed(scene, &opts, o, &pools, &mut progress)?;
             let first = each[0].times_ms.clone();
             for (m, pool) in each.into_iter().zip(&pools) {
                 let speedup = (pools.len() > 1).then(|| paired_ratio(&first, &m.times_ms));
@@ -186,8 +201,7 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
                     speedup,
                     phases: m.phases,
                     peak_rss_mb: peak_rss_mb(),
-                    foreign_cores,
-                    tries,
+                    disturbance,
                 });
             }
         }
@@ -228,11 +242,12 @@ fn measure_undisturbed(
     o: &BenchOptions,
     pools: &[rayon::ThreadPool],
     progress: &mut impl FnMut(&str),
-) -> Result<(Vec<Measured>, Option<f64>, usize)> {
+) -> Result<(Vec<Measured>, Disturbance)> {
+    let cores = pools.iter().map(|p| p.current_num_threads()).max().unwrap_or(1);
     let mut tries = 0;
     loop {
         tries += 1;
-        if o.undisturbed && !quiet::wait(QUIET, QUIET_WINDOW, QUIET_GIVE_UP) {
+        if o.undisturbed && !wait_for_quiet(cores) {
             progress("the machine did not go quiet in five minutes; timing anyway");
         }
         let monitor = Monitor::start();
@@ -248,12 +263,31 @@ fn measure_undisturbed(
             }
         }
         let foreign = monitor.foreign();
+        let contention = o.undisturbed.then(|| quiet::core_contention(cores));
         let each = timings.into_iter().map(Timing::finish).collect::<Result<Vec<_>>>()?;
-        if !o.undisturbed || !foreign.is_some_and(|f| f >= DISTURBED) || tries == TRIES {
-            return Ok((each, foreign, tries));
+        let disturbed = foreign.is_some_and(|f| f >= DISTURBED) || contention.is_some_and(|c| c >= CONTENDED);
+        if !o.undisturbed || !disturbed || tries == TRIES {
+            return Ok((each, Disturbance { foreign_cores: foreign, contention, tries }));
         }
-        progress(&format!("others used {:.2} cores meanwhile; timing again", foreign.unwrap_or(0.0)));
+        progress(&format!(
+            "others used {:.2} cores meanwhile, and all cores ran {:.2}x slower than one; timing again",
+            foreign.unwrap_or(0.0),
+            contention.unwrap_or(1.0)
+        ));
     }
+}
+
+/// Waits until other processes use under [`QUIET`] cores over [`QUIET_WINDOW`] and all
+/// `cores` run as fast as one (under [`CONTENDED`]), for at most [`QUIET_GIVE_UP`];
+/// whether they did.
+fn wait_for_quiet(cores: usize) -> bool {
+    let t0 = Instant::now();
+    while t0.elapsed() < QUIET_GIVE_UP {
+        if quiet::wait(QUIET, QUIET_WINDOW, QUIET_GIVE_UP - t0.elapsed()) && quiet::core_contention(cores) < CONTENDED {
+            return true;
+        }
+    }
+    false
 }
 
 /// The peak resident set of this process in MB (`VmHWM` in `/proc/self/status`; 0 where
@@ -287,7 +321,7 @@ pub fn table(rows: &[BenchRow]) -> String {
         for p in &phases {
             out += &format!(" {:>22}", r.phases.get(*p).map_or_else(|| "-".to_string(), cell));
         }
-        let others = r.foreign_cores.map_or_else(|| "-".to_string(), |f| format!("{f:.2}"));
+        let others = r.disturbance.foreign_cores.map_or_else(|| "-".to_string(), |f| format!("{f:.2}"));
         let speedup = r.speedup.map_or_else(|| "-".to_string(), |x| format!("{x:.2}"));
         out += &format!(" {:>9.0} {:>7} {:>8} {:>6}\n", r.peak_rss_mb, r.threads, speedup, others);
     }

@@ -61,6 +61,43 @@ pub(crate) fn wait(limit: f64, window: Duration, give_up: Duration) -> bool {
     false
 }
 
+/// How much slower the slowest of `threads` threads runs a fixed loop when all run it at
+/// once than the fastest runs it alone (the least of three tries each): about 1 when every
+/// core is free. A process outside this machine's view (another machine's work on the same
+/// physical cores, behind a virtual machine) shows here and not in [`Monitor::foreign`]:
+/// it slows some cores and not others, so a frame on all threads slows and one on a single
+/// thread may not.
+pub(crate) fn core_contention(threads: usize) -> f64 {
+    let threads = threads.max(1);
+    let alone = (0..3).map(|_| probe()).min().unwrap_or_default();
+    let together = (0..3)
+        .map(|_| {
+            let start = std::sync::Barrier::new(threads);
+            std::thread::scope(|s| {
+                let runs: Vec<_> = (0..threads).map(|_| s.spawn(|| (start.wait(), probe()).1)).collect();
+                runs.into_iter().map(|r| r.join().unwrap_or(Duration::MAX)).max().unwrap_or_default()
+            })
+        })
+        .min()
+        .unwrap_or_default();
+    together.as_secs_f64() / alone.as_secs_f64().max(1e-9)
+}
+
+/// The time of a fixed loop of arithmetic and reads from a small table (a few ms).
+fn probe() -> Duration {
+    let table: Vec<u64> = (0..4096u64).map(|i| i.wrapping_mul(0x9E37_79B9_7F4A_7C15)).collect();
+    let t = Instant::now();
+    let mut x = 0x2545_F491_4F6C_DD1Du64;
+    for _ in 0..2_000_000 {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x = x.wrapping_add(table[(x & 4095) as usize]);
+    }
+    std::hint::black_box(x);
+    t.elapsed()
+}
+
 /// The machine's busy ticks and this process's own, now.
 fn ticks() -> Option<(u64, u64)> {
     let machine = std::fs::read_to_string("/proc/stat").ok()?;
@@ -125,6 +162,15 @@ mod tests {
         let m = Monitor::start();
         std::thread::sleep(Duration::from_millis(30));
         assert!(m.foreign().is_some_and(|f| f.is_finite() && f >= 0.0));
+    }
+
+    #[test]
+    fn one_thread_runs_the_probe_as_fast_together_as_alone_within_the_noise() {
+        // One thread "together" is the same loop alone, so only the machine's noise parts
+        // the two; several threads give a finite ratio too.
+        let one = core_contention(1);
+        assert!((0.5..2.0).contains(&one), "{one}");
+        assert!(core_contention(2).is_finite());
     }
 
     #[cfg(target_os = "linux")]

@@ -223,6 +223,7 @@ fn bench_reports_spread_phases_and_memory() {
         assert_eq!(r["runs"], 3);
         assert_eq!(r["threads"], 2);
         assert_eq!(r["tries"], 1, "timed once unless asked to wait for a quiet machine");
+        assert!(r["contention"].is_null(), "the cores are probed only when asked to wait");
         if cfg!(target_os = "linux") {
             assert!(r["foreign_cores"].as_f64().is_some_and(|f| f >= 0.0), "{r}");
         }
