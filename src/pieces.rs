@@ -24,6 +24,18 @@ pub(crate) fn stretches<T>(mut list: &mut [T], lengths: impl IntoIterator<Item =
     out
 }
 
+/// Where each of consecutive stretches of the given lengths starts, the first at 0.
+pub(crate) fn starts(lengths: impl IntoIterator<Item = usize>) -> Vec<usize> {
+    let mut at = 0;
+    lengths
+        .into_iter()
+        .map(|n| {
+            at += n;
+            at - n
+        })
+        .collect()
+}
+
 /// The `parts` one after another in one list, item `x` of part `k` written as `f(k, x)`:
 /// each part fills its own stretch, in parallel (the list a serial loop over the parts would
 /// make).
@@ -49,6 +61,12 @@ mod tests {
         let lens: Vec<usize> = cut.iter().map(|s| s.len()).collect();
         assert_eq!(lens, [3, 0, 5]);
         assert_eq!((cut[0][0], cut[2][0], cut[2][4]), (0, 3, 7));
+    }
+
+    #[test]
+    fn stretches_start_where_the_ones_before_end() {
+        assert_eq!(starts([3, 0, 5, 1]), [0, 3, 3, 8]);
+        assert!(starts([]).is_empty());
     }
 
     #[test]

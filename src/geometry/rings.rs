@@ -6,7 +6,7 @@
 //! each ends: the parallel loops that make them fill one list a piece, and the pieces' lists
 //! are joined in parallel ([`Rings::joined`]).
 
-use crate::pieces::joined;
+use crate::pieces::{joined, starts};
 use glam::DVec2;
 
 /// A list of rings read by index: a list of lists or [`Rings`].
@@ -60,13 +60,7 @@ impl Rings {
     /// The rings of every part, in order, in one list: each part is copied into its own
     /// stretch of the list in parallel.
     pub fn joined(parts: &[Rings]) -> Rings {
-        let offsets: Vec<usize> = parts
-            .iter()
-            .scan(0, |at, p| {
-                *at += p.points.len();
-                Some(*at - p.points.len())
-            })
-            .collect();
+        let offsets = starts(parts.iter().map(|p| p.points.len()));
         let points: Vec<&[DVec2]> = parts.iter().map(|p| p.points.as_slice()).collect();
         let ends: Vec<&[usize]> = parts.iter().map(|p| p.ends.as_slice()).collect();
         Rings { points: joined(&points, |_, &p| p), ends: joined(&ends, |k, &end| end + offsets[k]) }

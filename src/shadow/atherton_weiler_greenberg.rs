@@ -722,19 +722,12 @@ impl Mapped {
             })
             .collect();
         // Each part's outlines start where the parts before it end.
-        let base: Vec<u32> = parts
-            .iter()
-            .scan(0, |at, m| {
-                let b = *at;
-                *at += m.points.len() as u32;
-                Some(b)
-            })
-            .collect();
+        let base = pieces::starts(parts.iter().map(|m| m.points.len()));
         let points: Vec<&[DVec2]> = parts.iter().map(|m| &m.points[..]).collect();
         let polys: Vec<&[MappedPolygon]> = parts.iter().map(|m| &m.polys[..]).collect();
         Mapped {
             points: pieces::joined(&points, |_, &p| p),
-            polys: pieces::joined(&polys, |k, &p| MappedPolygon { first: p.first + base[k], ..p }),
+            polys: pieces::joined(&polys, |k, &p| MappedPolygon { first: p.first + base[k] as u32, ..p }),
         }
     }
 
@@ -883,14 +876,7 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
         .map(|&q| local.get(q as usize).copied().unwrap_or(NO_ITEM))
         .collect();
     let edges_of = |&i: &usize| if sheet(&m.polys[i]) { m.polys[i].len as usize } else { 0 };
-    let first: Vec<usize> = kept
-        .iter()
-        .scan(0, |at, i| {
-            let f = *at;
-            *at += edges_of(i);
-            Some(f)
-        })
-        .collect();
+    let first = pieces::starts(kept.iter().map(edges_of));
     let items: Vec<Item> = kept
         .par_iter()
         .zip(&first)
