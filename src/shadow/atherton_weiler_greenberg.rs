@@ -1198,7 +1198,7 @@ impl ShadowDatabase {
                 .map(|(f, view)| {
                     let mut stats = Pass1::new(options);
                     // A polygon wholly inside one cube face is mapped into that face alone.
-                    let unseen = |i: usize| unseen[i] || face.get(i).is_some_and(|g| g.is_some_and(|g| g != f as u8));
+                    let unseen = |i: usize| unseen[i] || matches!(face.get(i), Some(&Some(g)) if g != f as u8);
                     let lit = lit_in_view(scene, unseen, view, extent, &mut stats).map_err(clip_error)?;
                     Ok((lit, stats))
                 })

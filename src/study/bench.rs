@@ -69,11 +69,19 @@ pub struct Spread {
 }
 
 impl Spread {
-    pub(crate) fn of(mut v: Vec<f64>) -> Spread {
-        v.sort_by(f64::total_cmp);
-        let median_ms = if v.is_empty() { 0.0 } else { v[v.len() / 2] };
-        Spread { median_ms, min_ms: v.first().copied().unwrap_or(0.0), max_ms: v.last().copied().unwrap_or(0.0) }
+    pub(crate) fn of(v: Vec<f64>) -> Spread {
+        let (min_ms, max_ms) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+        if v.is_empty() {
+            return Spread { median_ms: 0.0, min_ms: 0.0, max_ms: 0.0 };
+        }
+        Spread { median_ms: median(v), min_ms, max_ms }
     }
+}
+
+/// The median of `v` (the upper of the two middle values for an even count; 0 for none).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// One method's measurement.
@@ -229,8 +237,7 @@ fn pools(threads: &[usize]) -> Result<Vec<rayon::ThreadPool>> {
 /// The median over runs of `first[i] / other[i]`: how many times faster `other` ran than
 /// `first`, each run against the one beside it in time.
 fn paired_ratio(first: &[f64], other: &[f64]) -> f64 {
-    let ratios: Vec<f64> = first.iter().zip(other).map(|(a, b)| a / b.max(1e-9)).collect();
-    Spread::of(ratios).median_ms
+    median(first.iter().zip(other).map(|(a, b)| a / b.max(1e-9)).collect())
 }
 
 /// One method measured at every pool's thread count, in turn frame by frame (warm-up frames
@@ -283,7 +290,9 @@ fn measure_undisturbed(
 fn wait_for_quiet(cores: usize) -> bool {
     let t0 = Instant::now();
     while t0.elapsed() < QUIET_GIVE_UP {
-        if quiet::wait(QUIET, QUIET_WINDOW, QUIET_GIVE_UP - t0.elapsed()) && quiet::core_contention(cores) < CONTENDED {
+        if quiet::wait(QUIET, QUIET_WINDOW, QUIET_GIVE_UP.saturating_sub(t0.elapsed()))
+            && quiet::core_contention(cores) < CONTENDED
+        {
             return true;
         }
     }
