@@ -1139,11 +1139,14 @@ fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> 
         active.retain(|&k| casters[k].bounds.1.x >= a.bounds.0.x);
         for &k in &active {
             let b = &casters[k];
-            if !(back[i] || back[k]) || !a.overlaps(b) || regions_apart(&a.region, &b.region) {
-                continue;
+            // Whether the pair would clear either flag, asked before the dearer question
+            // whether their insides meet at all.
+            let clears_i = back[i] && !matches!(relation(b, a), Relation::Front);
+            let clears_k = back[k] && !matches!(relation(a, b), Relation::Front);
+            if (clears_i || clears_k) && a.overlaps(b) && !regions_apart(&a.region, &b.region) {
+                back[i] &= !clears_i;
+                back[k] &= !clears_k;
             }
-            back[i] &= matches!(relation(b, a), Relation::Front);
-            back[k] &= matches!(relation(a, b), Relation::Front);
         }
         active.push(i);
     }
