@@ -230,7 +230,7 @@ fn bench_reports_spread_phases_and_memory() {
     }
     assert_eq!(rows[3]["visibility"], "zbuffer");
     assert_eq!(rows[3]["shadows"], "crow");
-    assert!(rows.iter().all(|r| r["speedup"].is_null()), "one thread count, no speed-up");
+    assert!(rows.iter().all(|r| r["speedup"].is_null() && r["speedup_best"].is_null()), "one count, no speed-up");
     refused(&["bench", SMALL, "--runs", "0"], "at least one timed run");
     refused(&["bench", SMALL, "--threads", "1,0"], "0 threads");
 }
@@ -259,6 +259,11 @@ fn bench_compares_thread_counts_frame_by_frame() {
             pair[0]["max_ms"].as_f64().unwrap() / pair[1]["min_ms"].as_f64().unwrap(),
         );
         assert!(lo <= speedup && speedup <= hi, "{speedup} outside {lo}..{hi} ({one} ms / {two} ms)");
+        // The fastest frames against each other.
+        let best = pair[1]["speedup_best"].as_f64().unwrap();
+        let fastest = pair[0]["min_ms"].as_f64().unwrap() / pair[1]["min_ms"].as_f64().unwrap();
+        assert!((best - fastest).abs() <= 1e-9 * fastest, "{best} against {fastest}");
+        assert_eq!(pair[0]["speedup_best"], 1.0);
     }
 }
 
