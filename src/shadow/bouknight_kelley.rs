@@ -304,14 +304,34 @@ impl Wedge {
 #[derive(Debug, Clone, Copy)]
 struct Extent {
     /// Boxes in the 2D domain of the [`SphereGrid`] (two when the azimuth wraps).
-    boxes: [Option<[f64; 4]>; 2],
-    /// Point lights: the bounding cone's axis and half-angle (π covers everything).
-    cone: (DVec3, f64),
+    boxes: Boxes,
+    /// Point lights: the bounding cone (a half-angle of π covers everything).
+    cone: Cone,
+}
+
+/// An extent's boxes in the 2D domain of the [`SphereGrid`].
+type Boxes = [Option<[f64; 4]>; 2];
+
+/// A bounding cone from the light: its axis, its half-angle, and the half-angle's cosine
+/// and sine, so that cones are compared without an arccosine per pair. Kept apart from the
+/// boxes, in a list the pair loop reads at random, so that a caster's cone is one read.
+#[derive(Debug, Clone, Copy)]
+struct Cone {
+    axis: DVec3,
+    half: f64,
+    cos: f64,
+    sin: f64,
+}
+
+impl Cone {
+    fn new(axis: DVec3, half: f64) -> Cone {
+        Cone { axis, half, cos: half.cos(), sin: half.sin() }
+    }
 }
 
 impl Extent {
     /// The extent of a polygon that is neither caster nor receiver (never asked about).
-    const NONE: Extent = Extent { boxes: [None, None], cone: (DVec3::Y, 0.0) };
+    const NONE: Extent = Extent { boxes: [None, None], cone: Cone { axis: DVec3::Y, half: 0.0, cos: 1.0, sin: 0.0 } };
 }
 
 /// Step 2, the sphere prefilter: every polygon's extent on the sphere around the light (on
@@ -319,10 +339,9 @@ impl Extent {
 /// azimuth, or the plane's two axes) in which each caster is binned in every cell its extent
 /// touches.
 struct SphereGrid {
-    extents: Vec<Extent>,
-    /// Each extent's cone half-angle as (cosine, sine), so that cones are compared without
-    /// an arccosine per pair.
-    cone_cs: Vec<(f64, f64)>,
+    /// Each polygon's extent: its boxes, and its cone.
+    boxes: Vec<Boxes>,
+    cones: Vec<Cone>,
     domain: [f64; 4],
     g: usize,
     /// The casters binned in cell `k` (column-major, `c * g + r`) are
@@ -340,24 +359,24 @@ impl SphereGrid {
         for &i in casters.iter().chain(receivers) {
             wanted[i as usize] = true;
         }
-        let extents: Vec<Extent> = (0..n)
+        let (boxes, cones): (Vec<Boxes>, Vec<Cone>) = (0..n)
             .into_par_iter()
             .map(|i| if wanted[i] { extent(scene.verts(i), sample) } else { Extent::NONE })
-            .collect();
+            .map(|e| (e.boxes, e.cone))
+            .unzip();
         let domain = match sample {
             LightSample::Point(_) => [0.0, -PI, PI, PI],
-            LightSample::Directional(_) => extents
+            LightSample::Directional(_) => boxes
                 .iter()
-                .flat_map(|e| e.boxes.iter().flatten())
+                .flat_map(|b| b.iter().flatten())
                 .fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |d, b| {
                     [d[0].min(b[0]), d[1].min(b[1]), d[2].max(b[2]), d[3].max(b[3])]
                 }),
         };
         let g = ((casters.len() as f64).sqrt().ceil() as usize).clamp(4, 1024);
-        let cone_cs = extents.par_iter().map(|e| (e.cone.1.cos(), e.cone.1.sin())).collect();
         let mut grid = SphereGrid {
-            extents,
-            cone_cs,
+            boxes,
+            cones,
             domain,
             g,
             first: Vec::new(),
@@ -398,7 +417,7 @@ impl SphereGrid {
         let d = self.domain;
         let (lo, size) = (DVec2::new(d[0], d[1]), DVec2::new(d[2] - d[0], d[3] - d[1]).max(DVec2::splat(1e-300)));
         let g = self.g;
-        let boxes = self.extents[i as usize].boxes.into_iter().flatten();
+        let boxes = self.boxes[i as usize].into_iter().flatten();
         boxes.flat_map(move |b| grid_cells(lo, size, (g, g), (DVec2::new(b[0], b[1]), DVec2::new(b[2], b[3]))))
     }
 
@@ -408,7 +427,7 @@ impl SphereGrid {
     /// per polygon, that keeps each caster from being listed twice.
     fn candidates(&self, b: u32, stamp: &mut [u32], out: &mut Vec<u32>) {
         out.clear();
-        let (bc, bh) = self.extents[b as usize].cone;
+        let bc = self.cones[b as usize];
         for (c, r) in self.cells_of(b) {
             for &a in self.cell(c, r) {
                 if stamp[a as usize] == b {
@@ -420,9 +439,8 @@ impl SphereGrid {
                 // where the cosine falls) `ac·bc >= cos(ah + bh)`, with a hair of slack so
                 // that rounding can only keep a pair, never drop one.
                 let overlap = !self.point || {
-                    let (ac, ah) = self.extents[a as usize].cone;
-                    let ((ca, sa), (cb, sb)) = (self.cone_cs[a as usize], self.cone_cs[b as usize]);
-                    ah + bh >= PI || ac.dot(bc) >= ca * cb - sa * sb - 1e-12
+                    let ac = self.cones[a as usize];
+                    ac.half + bc.half >= PI || ac.axis.dot(bc.axis) >= ac.cos * bc.cos - ac.sin * bc.sin - 1e-12
                 };
                 if overlap {
                     out.push(a);
@@ -439,7 +457,7 @@ impl SphereGrid {
 fn extent(verts: &[DVec3], sample: LightSample) -> Extent {
     match sample {
         LightSample::Point(s) => {
-            let full = Extent { boxes: [Some([0.0, -PI, PI, PI]), None], cone: (DVec3::Y, PI) };
+            let full = Extent { boxes: [Some([0.0, -PI, PI, PI]), None], cone: Cone::new(DVec3::Y, PI) };
             let dirs: smallvec::SmallVec<[DVec3; 8]> = verts.iter().map(|&v| (v - s).normalize_or_zero()).collect();
             let axis = dirs.iter().sum::<DVec3>().normalize_or_zero();
             if axis == DVec3::ZERO || dirs.contains(&DVec3::ZERO) {
@@ -455,7 +473,7 @@ fn extent(verts: &[DVec3], sample: LightSample) -> Extent {
             let phi = axis.z.atan2(axis.x);
             let (t0, t1) = (theta - half, theta + half);
             if t0 <= 0.0 || t1 >= PI {
-                return Extent { boxes: [Some([t0.max(0.0), -PI, t1.min(PI), PI]), None], cone: (axis, half) };
+                return Extent { boxes: [Some([t0.max(0.0), -PI, t1.min(PI), PI]), None], cone: Cone::new(axis, half) };
             }
             let dphi = (half.sin() / theta.sin()).min(1.0).asin() + 1e-9;
             let (p0, p1) = (phi - dphi, phi + dphi);
@@ -466,7 +484,7 @@ fn extent(verts: &[DVec3], sample: LightSample) -> Extent {
             } else {
                 [Some([t0, p0, t1, p1]), None]
             };
-            Extent { boxes, cone: (axis, half) }
+            Extent { boxes, cone: Cone::new(axis, half) }
         }
         LightSample::Directional(d) => {
             let u = d.any_orthonormal_vector();
@@ -475,7 +493,7 @@ fn extent(verts: &[DVec3], sample: LightSample) -> Extent {
                 let (x, y) = (p.dot(u), p.dot(v));
                 [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)]
             });
-            Extent { boxes: [Some(b), None], cone: (d, PI) }
+            Extent { boxes: [Some(b), None], cone: Cone::new(d, PI) }
         }
     }
 }
