@@ -1266,11 +1266,24 @@ impl<'a> AthertonWeilerGreenberg<'a> {
             Some(_) => {
                 return Err(Error::InvalidOption("the shadow database does not match the scene's lights".into()))
             }
-            None => Arc::new(
-                (0..ctx.scene.lights.len())
-                    .map(|l| ShadowDatabase::build(ctx.scene, l, options, counters))
-                    .collect::<Result<_>>()?,
-            ),
+            None => {
+                // The lights are independent: built side by side, one light's last cube face
+                // overlaps the next light's work. Counters are merged in light order.
+                let built: Vec<(ShadowDatabase, Counters)> = (0..ctx.scene.lights.len())
+                    .into_par_iter()
+                    .with_max_len(1)
+                    .map(|l| {
+                        let mut c = Counters::default();
+                        Ok((ShadowDatabase::build(ctx.scene, l, options, &mut c)?, c))
+                    })
+                    .collect::<Result<_>>()?;
+                let mut databases = Vec::with_capacity(built.len());
+                for (db, c) in built {
+                    counters.merge(&c);
+                    databases.push(db);
+                }
+                Arc::new(databases)
+            }
         };
         let view = ctx.view;
         let mut detail = Vec::new();
