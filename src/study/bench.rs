@@ -204,8 +204,9 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
             let (each, disturbance) = measure_undisturbed(scene, &opts, o, &pools, &mut progress)?;
             let (first, first_min) = (each[0].times_ms.clone(), each[0].frame.min_ms);
             for (m, pool) in each.into_iter().zip(&pools) {
-                let speedup = (pools.len() > 1).then(|| paired_ratio(&first, &m.times_ms));
-                let speedup_best = (pools.len() > 1).then(|| first_min / m.frame.min_ms.max(1e-9));
+                let several = pools.len() > 1;
+                let speedup = several.then(|| paired_ratio(&first, &m.times_ms));
+                let speedup_best = several.then(|| times_faster(first_min, m.frame.min_ms));
                 rows.push(BenchRow {
                     visibility: v.name().into(),
                     shadows: s.name().into(),
@@ -244,7 +245,13 @@ fn pools(threads: &[usize]) -> Result<Vec<rayon::ThreadPool>> {
 /// The median over runs of `first[i] / other[i]`: how many times faster `other` ran than
 /// `first`, each run against the one beside it in time.
 fn paired_ratio(first: &[f64], other: &[f64]) -> f64 {
-    median(first.iter().zip(other).map(|(a, b)| a / b.max(1e-9)).collect())
+    median(first.iter().zip(other).map(|(&a, &b)| times_faster(a, b)).collect())
+}
+
+/// How many times faster a frame of `b` ms ran than one of `a` ms (a zero time read as a
+/// nanosecond).
+fn times_faster(a: f64, b: f64) -> f64 {
+    a / b.max(1e-9)
 }
 
 /// One method measured at every pool's thread count, in turn frame by frame (warm-up frames
@@ -327,6 +334,7 @@ pub fn table(rows: &[BenchRow]) -> String {
     phases.sort_by_key(|p| (ORDER.iter().position(|o| o == p).unwrap_or(ORDER.len()), *p));
     phases.dedup();
     let cell = |s: &Spread| format!("{:.1} ({:.1}–{:.1})", s.median_ms, s.min_ms, s.max_ms);
+    let ratio = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |x| format!("{x:.2}"));
     let mut out = format!("{:<10} {:<26} {:>24}", "visibility", "shadows", "frame ms: median (min–max)");
     for p in &phases {
         out += &format!(" {:>22}", p);
@@ -338,7 +346,6 @@ pub fn table(rows: &[BenchRow]) -> String {
             out += &format!(" {:>22}", r.phases.get(*p).map_or_else(|| "-".to_string(), cell));
         }
         let others = r.disturbance.foreign_cores.map_or_else(|| "-".to_string(), |f| format!("{f:.2}"));
-        let ratio = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |x| format!("{x:.2}"));
         let (speedup, best) = (ratio(r.speedup), ratio(r.speedup_best));
         out += &format!(" {:>9.0} {:>7} {:>8} {:>6} {:>6}\n", r.peak_rss_mb, r.threads, speedup, best, others);
     }
