@@ -52,7 +52,7 @@ pub fn is_convex(ring: &[DVec2]) -> bool {
 /// overlap it (the subject is all outside).
 pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Option<Split> {
     let (sb, cb) = (ring_bounds(subject)?, ring_bounds(clip)?);
-    let eps = 1e-9 * (sb.1.max(cb.1) - sb.0.min(cb.0)).length().max(1e-300);
+    let eps = super::tolerance(sb.0.min(cb.0), sb.1.max(cb.1));
     let (s_turn, c_turn) = (turn(subject), turn(clip));
     if s_turn == 0.0 || c_turn == 0.0 || apart(subject, s_turn, clip, eps) || apart(clip, c_turn, subject, eps) {
         return None;

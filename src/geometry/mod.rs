@@ -184,6 +184,17 @@ where
     }
 }
 
+/// The tolerance of the 2D clippers for inputs with bounding box `lo`..`hi`: `1e-9` of its
+/// diagonal, but never finer than 64 times the spacing of doubles at the largest coordinate
+/// (tiny pieces far from the origin, 1e-5 across at coordinates in the thousands, would
+/// otherwise get a tolerance finer than their coordinates can resolve, and the predicates
+/// built on it disagree).
+pub(crate) fn tolerance(lo: glam::DVec2, hi: glam::DVec2) -> f64 {
+    let size = 1e-9 * (hi - lo).length();
+    let magnitude = lo.abs().max(hi.abs()).max_element();
+    size.max(64.0 * f64::EPSILON * magnitude).max(1e-300)
+}
+
 /// Whether `p` lies inside the 2D polygon `ring` by the even-odd rule, with the scan
 /// converter's half-open convention: an edge is crossed for `y_top <= p.y < y_bottom`, and a
 /// point is inside a span `[x_left, x_right)` that the crossings bound.

@@ -26,7 +26,8 @@
 //!
 //! Identical polygons come out as all-inside; polygons sharing an edge as touching, not
 //! overlapping. Tolerance: points within `1e-9 ×` the inputs' bounding-box diagonal are the
-//! same point. Every loop is bounded by the number of edges; a vertex where the edges do not
+//! same point (never less than 64 doubles' spacing at the largest coordinate:
+//! [`super::tolerance`]). Every loop is bounded by the number of edges; a vertex where the edges do not
 //! balance (which only badly inconsistent input can cause) is an error, never a panic or a
 //! hang. There is no limit on vertex counts. Inputs should be simple: rings may touch each
 //! other at vertices or run back along themselves (bridges), but an edge should not cross
@@ -105,10 +106,13 @@ pub fn ring_bounds(ring: &[DVec2]) -> Option<(DVec2, DVec2)> {
     Some(ring.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
 }
 
-/// The signed area of a ring (positive counter-clockwise).
+/// The signed area of a ring (positive counter-clockwise), summed over the triangles from its
+/// first corner: the products are of the ring's own extent, not of its coordinates, so a tiny
+/// ring far from the origin keeps its sign (products of coordinates in the thousands would
+/// cancel to noise larger than a ring 1e-5 across).
 pub fn signed_area(ring: &[DVec2]) -> f64 {
-    let n = ring.len();
-    (0..n).map(|i| ring[i].perp_dot(ring[(i + 1) % n])).sum::<f64>() * 0.5
+    let Some(&o) = ring.first() else { return 0.0 };
+    ring.windows(2).map(|w| (w[0] - o).perp_dot(w[1] - o)).sum::<f64>() * 0.5
 }
 
 /// The rings of `r` (pairs of one ring twice dropped: [`without_pairs`]) oriented with the
@@ -260,7 +264,7 @@ pub fn clip(subject: &Region, clip: &Region) -> Result<Clipped, ClipError> {
     let (Some(sb), Some(cb)) = (subject.bounds(), clip.bounds()) else {
         return Ok(Clipped { inside: Region::default(), outside: subject.clone() });
     };
-    let eps = 1e-9 * (sb.1.max(cb.1) - sb.0.min(cb.0)).length().max(1e-300);
+    let eps = super::tolerance(sb.0.min(cb.0), sb.1.max(cb.1));
     let (s_rings, c_rings, far) = rings_that_meet(subject, clip, (sb, cb), eps);
     if s_rings.is_empty() || c_rings.is_empty() || apart(&s_rings, &c_rings) {
         return Ok(Clipped {
@@ -653,6 +657,98 @@ mod tests {
             clip(&Region::from_ring(vec![DVec2::new(f64::NAN, 0.0), DVec2::X, DVec2::Y]), &square(0.0, 0.0, 1.0)),
             Err(ClipError::NonFinite)
         );
+    }
+
+    /// Tiny pieces far from the origin, as AWG met them on random scenes with offset
+    /// coordinates (the inputs are the failing ones): the pieces are some 1e-5 across at
+    /// coordinates in the thousands, where neighbouring doubles lie 5e-13 apart, so a
+    /// tolerance of 1e-9 of their size (3e-14) is finer than the coordinates and the
+    /// predicates disagreed. The clip must close its rings and keep the subject's area.
+    #[test]
+    fn tiny_pieces_far_from_the_origin() {
+        let v = DVec2::new;
+        let cases: [(Vec<Ring>, Vec<Ring>); 4] = [
+            (
+                vec![vec![
+                    v(546.85970520216, -2978.304518285927),
+                    v(546.8597008632871, -2978.304514260192),
+                    v(546.8597237740616, -2978.304506208707),
+                    v(546.8597237740616, -2978.304506645851),
+                    v(546.8597131985767, -2978.304518285927),
+                ]],
+                vec![vec![
+                    v(546.8597016363442, -2978.3045178067346),
+                    v(546.8596939291484, -2978.3045068431743),
+                    v(546.8596939291484, -2978.304503177905),
+                    v(546.8597099451536, -2978.3045081268974),
+                ]],
+            ),
+            (
+                vec![vec![
+                    v(3288.8561345895055, 833.9728028104239),
+                    v(3288.863339900563, 833.952859912589),
+                    v(3288.86333990126, 833.952859912589),
+                    v(3288.856134590698, 833.9728028092769),
+                ]],
+                vec![
+                    vec![
+                        v(3289.0715870366967, 834.2518439970196),
+                        v(3289.057768689382, 834.2518439970196),
+                        v(3289.0715870366967, 834.2256953280641),
+                    ],
+                    vec![
+                        v(3289.0570806945157, 834.0028059903347),
+                        v(3289.0570786101694, 833.995634756759),
+                        v(3289.0715870366967, 833.986853294247),
+                        v(3289.0715870366967, 833.9909655998252),
+                    ],
+                    vec![
+                        v(3288.753177751773, 834.2518439970196),
+                        v(3288.496115145298, 834.2518439970196),
+                        v(3288.496115145298, 834.1409279435327),
+                        v(3288.6570616124072, 834.1381730339094),
+                        v(3288.759743041273, 833.952859912589),
+                        v(3288.8768601039246, 833.952859912589),
+                        v(3288.761792630418, 834.063582320819),
+                    ],
+                ],
+            ),
+            (
+                vec![vec![
+                    v(686.1697755633336, -1923.4710771010289),
+                    v(686.1697697619961, -1923.4710771010289),
+                    v(686.1697683196506, -1923.471075570996),
+                    v(686.1697755633336, -1923.4710718798142),
+                ]],
+                vec![vec![
+                    v(686.1697598981827, -1923.4710628303774),
+                    v(686.1697722794737, -1923.4710771010289),
+                    v(686.1697679550787, -1923.4710771010289),
+                    v(686.1697592276207, -1923.4710628303774),
+                ]],
+            ),
+            (
+                vec![vec![
+                    v(656.9391615733607, -348.99863398406563),
+                    v(656.9391591658189, -348.99863418709344),
+                    v(656.9391591686965, -348.9986343075248),
+                    v(656.9391615733832, -348.9986341459988),
+                ]],
+                vec![vec![
+                    v(656.939161571027, -348.9986172071396),
+                    v(656.9391589501404, -348.9986172071396),
+                    v(656.9391589516183, -348.9986363691061),
+                    v(656.9391615736591, -348.99863612926333),
+                ]],
+            ),
+        ];
+        for (k, (s, c)) in cases.into_iter().enumerate() {
+            let (s, c) = (Region { rings: s }, Region { rings: c });
+            let got = clip(&s, &c).unwrap_or_else(|e| panic!("case {k}: {e}"));
+            let whole = s.area();
+            let sum = got.inside.area() + got.outside.area();
+            assert!((sum - whole).abs() <= 1e-3 * whole.abs(), "case {k}: {sum} against {whole}");
+        }
     }
 
     /// Two neighbouring triangles' shadows (one region, sharing an edge) whose shared edge

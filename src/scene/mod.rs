@@ -7,9 +7,9 @@ mod obj;
 mod solids;
 pub use build::SceneBuilder;
 pub(crate) use obj::ObjText;
+pub(crate) use solids::Solid;
 #[cfg(test)]
 pub(crate) use solids::NO_SOLID;
-pub(crate) use solids::{Closure, Solid};
 mod write;
 
 /// No polygon (in [`Scene::across`]).
@@ -479,11 +479,8 @@ pub struct Scene {
     pub(crate) face_count: u32,
     /// Each polygon's closed solid (an index into `solids`), or [`NO_SOLID`].
     pub(crate) solid_of: Vec<u32>,
-    /// The closed, consistently wound surfaces among the objects' polygons (closed but for
-    /// holes: see `solids`).
+    /// The closed, consistently wound surfaces among the objects' polygons (see `solids`).
     pub(crate) solids: Vec<Solid>,
-    /// Parallel to `solids`: each solid's holes, as the rings caps over them would run.
-    pub(crate) solid_holes: Vec<Vec<Vec<DVec3>>>,
     /// Parallel to `vertices`: the polygon across the edge from each corner to the next,
     /// where exactly one other polygon of the object runs that edge the other way (between
     /// the same welded positions), or [`NO_POLYGON`].
@@ -551,7 +548,6 @@ impl Scene {
             face_count: 0,
             solid_of: Vec::new(),
             solids: Vec::new(),
-            solid_holes: Vec::new(),
             across: Vec::new(),
             polygons_id: next_polygons_id(),
             bounds: None,
@@ -631,7 +627,6 @@ impl Scene {
             let found = solids::find(&corners, self.solids.len() as u32);
             self.solid_of.extend(found.solid_of);
             self.solids.extend(found.solids);
-            self.solid_holes.extend(found.holes);
             let p0 = self.polygons.len() as u32 - ranges.len() as u32;
             self.across
                 .extend(found.across.into_iter().map(|q| if q == solids::NO_SOLID { NO_POLYGON } else { p0 + q }));
@@ -779,26 +774,22 @@ impl Scene {
         &self.vertices[p.start as usize..(p.start + p.len) as usize]
     }
 
-    /// `closed[s]`: how solid `s` looks from `from` (a light sample or the eye): open, or
-    /// closed but for some windows (holes a cap turned away from `from` could not close;
-    /// see `solids`). [`Scene::turned_away_on_solid`] needs it.
-    pub(crate) fn closed_from(&self, from: LightSample) -> Vec<solids::Closure> {
-        self.solids.iter().zip(&self.solid_holes).map(|(s, holes)| solids::closed_from(s, holes, from)).collect()
+    /// `closed[s]`: whether solid `s` is closed as seen from `from` (a light sample or the
+    /// eye), which lies outside its bounds. [`Scene::turned_away_on_solid`] needs it.
+    pub(crate) fn closed_from(&self, from: LightSample) -> Vec<bool> {
+        self.solids.iter().map(|s| s.closed_from(from)).collect()
     }
 
     /// Whether polygon `i` belongs to a solid closed as seen from `from` (`closed`, from
-    /// [`Scene::closed_from`]), turns its back to `from`, and cannot be seen through one of
-    /// the solid's windows. Seen from `from`, such a polygon is covered everywhere by a
-    /// polygon of the same solid that faces `from`, nearer along every ray (where the two
-    /// meet, at their shared edge, at the same distance): it never casts a shadow, and is
-    /// never the nearest polygon seen. Ours, not the papers'; see
+    /// [`Scene::closed_from`]) and turns its back to `from`. Seen from `from`, such a polygon
+    /// is covered everywhere by a polygon of the same solid that faces `from`, nearer along
+    /// every ray (where the two meet, at their shared edge, at the same distance): it never
+    /// casts a shadow, and is never the nearest polygon seen. Ours, not the papers'; see
     /// `docs/algorithms/bouknight-kelley.md`, "Speed-ups that are ours", and
     /// `docs/algorithms/scanline.md`.
-    pub(crate) fn turned_away_on_solid(&self, i: usize, from: LightSample, closed: &[solids::Closure]) -> bool {
+    pub(crate) fn turned_away_on_solid(&self, i: usize, from: LightSample, closed: &[bool]) -> bool {
         let s = self.solid_of[i] as usize;
-        let Some(solids::Closure::Closed(windows)) = closed.get(s) else { return false };
-        from.side_of(&self.polygons[i].plane) * self.solids[s].sign < 0.0
-            && !windows.iter().any(|w| w.may_show(self.verts(i)))
+        closed.get(s) == Some(&true) && from.side_of(&self.polygons[i].plane) * self.solids[s].sign < 0.0
     }
 
     /// Whether polygon `i` is one piece of a non-planar face split into a fan (its face has
@@ -832,7 +823,6 @@ impl Scene {
     /// the new polygons), and the polygons take a new [`Scene::polygons_id`].
     pub(crate) fn polygons_changed(&mut self) {
         self.solids.clear();
-        self.solid_holes.clear();
         self.solid_of.clear();
         self.solid_of.resize(self.polygons.len(), solids::NO_SOLID);
         self.across.clear();

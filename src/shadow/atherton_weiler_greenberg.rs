@@ -183,7 +183,7 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
         if norm == 0.0 {
             return Ok((dc > 0.0).then(|| q.clone()));
         }
-        let eps = 1e-9 * (hi - lo).length().max(1e-300);
+        let eps = crate::geometry::tolerance(lo, hi);
         let (front, _) = convex_split::cut(&q.region.rings[0], |p| (da * p.x + db * p.y + dc) / norm, eps);
         return Ok(front.and_then(|r| Piece::convex(q.source, r, q.near)));
     }

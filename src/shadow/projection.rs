@@ -30,12 +30,7 @@ pub fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> boo
 /// sample lies outside the solid's bounds: such a polygon never needs to cast, since a
 /// shadow ray that crosses it has crossed, nearer the light, a polygon of the same solid
 /// that faces the light ([`Scene::turned_away_on_solid`]).
-pub(crate) fn faces_away_on_solid(
-    scene: &Scene,
-    i: usize,
-    sample: LightSample,
-    closed: &[crate::scene::Closure],
-) -> bool {
+pub(crate) fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample, closed: &[bool]) -> bool {
     scene.turned_away_on_solid(i, sample, closed)
 }
 
