@@ -256,6 +256,146 @@ pub fn random(seed: u64, opts: RandomOptions) -> Result<Scene> {
     )
 }
 
+/// A random adversarial scene from `seed`, for the differential tests of the culls of ours
+/// (`tests/suite/shadows.rs`): [`random`]'s polygons, among them what found the wrong
+/// pixels of `tests/data/solids/` and `tests/data/awg-area/`. Open meshes beside closed ones:
+/// a bumpy grid sheet, a fan of a non-planar polygon, a box with a face left out; closed
+/// solids wound either way, some casting no shadow (an icosahedron, a box); non-planar quads
+/// (split into fans) under an area light; and, half the time, a directional light grazing a
+/// sheet of coplanar neighbours.
+pub fn adversarial(seed: u64, opts: RandomOptions) -> Result<Scene> {
+    let base = random(seed, opts)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xad5e_5a11);
+    let mut objects = base.objects().to_vec();
+    let mut lights = base.lights().to_vec();
+    let mut at = || DVec3::new(rng.gen_range(-1.8..1.8), rng.gen_range(0.3..1.8), rng.gen_range(-1.8..1.8));
+    let (grid_at, fan_at, box_at, ico_at, quad_at) = (at(), at(), at(), at(), at());
+    let mut add = |mesh: Mesh, casts: bool| objects.push(Object { casts_shadows: casts, ..object(0, mesh) });
+    add(bumpy_grid(&mut rng, grid_at), true);
+    add(Mesh::from_polygons(&[bumpy_fan(&mut rng, fan_at)]), true);
+    let mut open_box = Mesh::default();
+    add_box(&mut open_box, box_at, box_at + DVec3::splat(rng.gen_range(0.3..0.9)), rng.gen_bool(0.5));
+    let keep = open_box.faces.len() - if open_box.faces.len() == 12 { 2 } else { 1 };
+    open_box.faces.truncate(keep);
+    add(open_box, true);
+    let inward = rng.gen_bool(0.5);
+    add(icosahedron(ico_at, rng.gen_range(0.3..0.8), inward), rng.gen_bool(0.5));
+    let quads: Vec<Vec<DVec3>> = (0..3).map(|_| bumpy_quad(&mut rng, quad_at)).collect();
+    add(Mesh::from_polygons(&quads), true);
+    lights.push(Light {
+        kind: LightKind::Area {
+            corner: quad_at + DVec3::new(-0.5, rng.gen_range(1.0..2.5), -0.5),
+            edge_u: DVec3::new(rng.gen_range(0.3..1.0), 0.0, 0.0),
+            edge_v: DVec3::new(0.0, 0.0, rng.gen_range(0.3..1.0)),
+            samples: [rng.gen_range(1..4), rng.gen_range(1..4)],
+        },
+        color: Vec3::ONE,
+        intensity: 0.5,
+        attenuation: [1.0, 0.0, 0.0],
+    });
+    if rng.gen_bool(0.5) {
+        // Grazing the grid sheet's mean plane (y up), a little above it.
+        let a = rng.gen_range(0.0..2.0 * PI);
+        let direction = DVec3::new(a.cos(), -rng.gen_range(0.01..0.08), a.sin()).normalize();
+        lights.push(Light { kind: LightKind::Directional { direction }, ..point_light(DVec3::ZERO) });
+    }
+    Scene::new(base.camera().clone(), RenderSettings::default(), base.materials().to_vec(), lights, objects)
+}
+
+/// A 4 x 4 grid of triangles around `c`, its heights random: an open, non-planar sheet.
+fn bumpy_grid(rng: &mut ChaCha8Rng, c: DVec3) -> Mesh {
+    let h: Vec<f64> = (0..25).map(|_| rng.gen_range(-0.15..0.15)).collect();
+    let p = |x: usize, z: usize| c + DVec3::new(x as f64 * 0.3 - 0.6, h[x * 5 + z], z as f64 * 0.3 - 0.6);
+    let mut tris = Vec::new();
+    for x in 0..4 {
+        for z in 0..4 {
+            tris.push(vec![p(x, z), p(x, z + 1), p(x + 1, z)]);
+            tris.push(vec![p(x + 1, z), p(x, z + 1), p(x + 1, z + 1)]);
+        }
+    }
+    Mesh::from_polygons(&tris)
+}
+
+/// A non-planar polygon of 5 to 9 corners around `c` (the loader splits it into a fan).
+fn bumpy_fan(rng: &mut ChaCha8Rng, c: DVec3) -> Vec<DVec3> {
+    let n = rng.gen_range(5..10);
+    let r = rng.gen_range(0.3..0.9);
+    (0..n)
+        .map(|i| {
+            let t = 2.0 * PI * i as f64 / n as f64;
+            c + DVec3::new(r * t.cos(), rng.gen_range(-0.3..0.3), r * t.sin())
+        })
+        .collect()
+}
+
+/// A non-planar quad near `c`.
+fn bumpy_quad(rng: &mut ChaCha8Rng, c: DVec3) -> Vec<DVec3> {
+    let mut j = || DVec3::new(rng.gen_range(-0.6..0.6), rng.gen_range(-0.3..0.3), rng.gen_range(-0.6..0.6));
+    let o = c + j() * 0.5;
+    let s = 0.5;
+    vec![
+        o + j() * 0.2,
+        o + DVec3::new(s, 0.0, 0.0) + j() * 0.2,
+        o + DVec3::new(s, 0.0, s) + j() * 0.2,
+        o + DVec3::new(0.0, 0.0, s) + j() * 0.2,
+    ]
+}
+
+/// A closed icosahedron of radius `r` at `c`, wound outward, or inward when `inward`.
+fn icosahedron(c: DVec3, r: f64, inward: bool) -> Mesh {
+    let g = (1.0 + 5f64.sqrt()) / 2.0;
+    let v: Vec<DVec3> = [
+        (-1.0, g, 0.0),
+        (1.0, g, 0.0),
+        (-1.0, -g, 0.0),
+        (1.0, -g, 0.0),
+        (0.0, -1.0, g),
+        (0.0, 1.0, g),
+        (0.0, -1.0, -g),
+        (0.0, 1.0, -g),
+        (g, 0.0, -1.0),
+        (g, 0.0, 1.0),
+        (-g, 0.0, -1.0),
+        (-g, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| c + DVec3::new(x, y, z).normalize() * r)
+    .collect();
+    const F: [[usize; 3]; 20] = [
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let faces: Vec<Vec<DVec3>> = F
+        .iter()
+        .map(|f| {
+            let mut t = vec![v[f[0]], v[f[1]], v[f[2]]];
+            if inward {
+                t.reverse();
+            }
+            t
+        })
+        .collect();
+    Mesh::from_polygons(&faces)
+}
+
 /// One random polygon of [`random`]: convex, or a star (concave), in a random orientation;
 /// the first may straddle the camera's near plane.
 fn random_polygon(rng: &mut ChaCha8Rng, first: bool, eye: DVec3) -> Vec<DVec3> {

@@ -26,12 +26,15 @@ pub fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> boo
     }
 }
 
-/// Whether polygon `i` belongs to a closed solid, faces away from the light sample, and the
-/// sample lies outside the solid's bounds: such a polygon never needs to cast, since a
-/// shadow ray that crosses it has crossed, nearer the light, a polygon of the same solid
-/// that faces the light ([`Scene::turned_away_on_solid`]).
+/// Whether polygon `i` belongs to a closed solid that casts shadows, faces away from the light
+/// sample, and the sample lies outside the solid's bounds: such a polygon never needs to
+/// cast, since a shadow ray that crosses it has crossed, nearer the light, a polygon of the
+/// same solid that faces the light ([`Scene::turned_away_on_solid`]), and is never lit, for
+/// the same reason. A solid that casts no shadow hides nothing, so its polygons turned away
+/// are lit through it (`tests/data/awg-area/wrong_120218.toml`, an inward-wound icosahedron
+/// that casts none).
 pub(crate) fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample, closed: &[bool]) -> bool {
-    scene.turned_away_on_solid(i, sample, closed)
+    scene.casts_shadows(i) && scene.turned_away_on_solid(i, sample, closed)
 }
 
 /// `unseen[i]`: whether light sample `sample` need not consider polygon `i`, found in
