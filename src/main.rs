@@ -637,6 +637,12 @@ fn compare_command(a: CompareArgs) -> umbra::Result<()> {
             r.interior_pixels,
             r.status
         );
+        if let Some(c) = r.map_errors {
+            table += &format!(
+                "{:>38} acne {}, detached {}, aliasing {}, resolution {}\n",
+                "by cause:", c.acne, c.detached, c.aliasing, c.resolution
+            );
+        }
     }
     stdout(&table)?;
     say(&format!("wrote {}", a.out.join("report.html").display()))

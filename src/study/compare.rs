@@ -71,6 +71,9 @@ pub struct MethodResult {
     pub wrong_pixels: usize,
     /// `wrong_pixels / interior_pixels`.
     pub error_share: f64,
+    /// A shadow map's wrong interior pixels by cause ([`super::map_errors`]); `None` for
+    /// other methods.
+    pub map_errors: Option<super::map_errors::MapErrors>,
     /// The image, relative to the report.
     pub image: String,
     /// The diff image, relative to the report.
@@ -168,7 +171,11 @@ pub fn compare(
             bar.advance(opts.runs.max(1) as u64);
             results.push(match measured {
                 None => MethodResult::not_run(v, s, status),
-                Some(m) => MethodResult::measured(v, s, status, &m, &reference, |img, file| save(img, file))?,
+                Some(m) => {
+                    let mut r = MethodResult::measured(v, s, status, &m, &reference, |img, file| save(img, file))?;
+                    r.map_errors = map_errors(scene, v, s, &reference, &m.last.frame)?;
+                    r
+                }
             });
         }
     }
@@ -188,6 +195,20 @@ pub fn compare(
     Ok(report)
 }
 
+/// A shadow map's wrong pixels by cause: the frame `got` of method `s` behind `v` against
+/// `reference`, with the same map rendered once more without bias; `None` for other methods.
+fn map_errors(
+    scene: &Scene,
+    v: VisibilityMethod,
+    s: &ShadowMethod,
+    reference: &Frame,
+    got: &Frame,
+) -> Result<Option<super::map_errors::MapErrors>> {
+    let Some(unbiased) = super::map_errors::without_bias(s) else { return Ok(None) };
+    let unbiased = render(scene, &RenderOptions { visibility: v, shadows: unbiased, ..RenderOptions::default() })?;
+    Ok(Some(super::map_errors::classify(reference, got, &unbiased.frame)))
+}
+
 impl MethodResult {
     /// A method that was not measured (not applicable to the scene, or failed), with why.
     fn not_run(v: VisibilityMethod, s: &ShadowMethod, status: String) -> MethodResult {
@@ -202,6 +223,7 @@ impl MethodResult {
             interior_pixels: 0,
             wrong_pixels: 0,
             error_share: 0.0,
+            map_errors: None,
             image: String::new(),
             diff: String::new(),
             counters: BTreeMap::new(),
@@ -239,6 +261,7 @@ impl MethodResult {
             interior_pixels: interior,
             wrong_pixels: wrong,
             error_share: wrong as f64 / interior.max(1) as f64,
+            map_errors: None,
             image: save(run.frame.color_image(None), &format!("{id}.png"))?,
             diff: save(diff_img, &format!("{id}-diff.png"))?,
             counters,
@@ -472,6 +495,7 @@ fn results_table(report: &Report, out: &Path, h: &mut String) {
         "rest (ms)",
         "wrong / interior",
         "error",
+        "shadow map's wrong pixels: acne / detached / aliasing / resolution",
     ] {
         let _ = write!(h, "<th>{col}</th>");
     }
@@ -487,7 +511,7 @@ fn results_table(report: &Report, out: &Path, h: &mut String) {
         };
         let _ = writeln!(
             h,
-            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td{noisy}>{:.1} ({:.1}–{:.1})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td></tr>",
+            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td{noisy}>{:.1} ({:.1}–{:.1})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td><td>{}</td></tr>",
             super::method_link(&r.visibility, out),
             super::method_link(&r.shadows, out),
             escape(&r.status),
@@ -502,10 +526,18 @@ fn results_table(report: &Report, out: &Path, h: &mut String) {
             rest(r),
             r.wrong_pixels,
             r.interior_pixels,
-            100.0 * r.error_share
+            100.0 * r.error_share,
+            r.map_errors.map_or(String::new(), |c| format!("{} / {} / {} / {}", c.acne, c.detached, c.aliasing, c.resolution))
         );
     }
     h.push_str("</tbody>\n</table>\n");
+    h.push_str(
+        "<p>A shadow map's wrong interior pixels by cause: <em>acne</em>, darker than exact away from every \
+         shadow edge (a lit surface shadowing itself); <em>detached</em>, lighter than exact where the same map \
+         without bias is right (the bias let the receiver pass its caster); <em>aliasing</em>, wrong within three \
+         pixels of a shadow edge of the exact image; <em>resolution</em>, lighter than exact away from every edge \
+         and wrong without bias too (a caster lost between texels).</p>\n",
+    );
 }
 
 /// The reference, and each method's image beside its diff.

@@ -8,6 +8,7 @@ pub mod bench;
 pub mod compare;
 #[cfg(feature = "explore")]
 pub mod explore;
+pub mod map_errors;
 #[cfg(feature = "plots")]
 mod plot;
 mod quiet;
