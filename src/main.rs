@@ -142,19 +142,20 @@ struct ShadowArgs {
     slope_bias: f64,
     /// Williams: move each lookup along the receiver's normal by this many texels of the map
     /// (normal-offset shadows; 0 is off).
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 1.0)]
     normal_offset: f64,
     /// Williams: receiver-plane depth bias: compare each PCF texel with the receiver's plane
     /// extrapolated to it.
     #[arg(long)]
     receiver_plane: bool,
-    /// Williams: nearest (one texel), pcf (percentage-closer filtering over --pcf-size²
-    /// texels), or soft-edge (Shastry's "Soft-Edged Shadows": PCF into a screen buffer, then a 15-tap Gaussian blur).
-    #[arg(long, value_enum, default_value = "pcf")]
-    shadow_filter: FilterArg,
-    /// Williams: the PCF kernel's side in texels (odd; 3 is Shastry's kernel).
-    #[arg(long, default_value_t = 3)]
-    pcf_size: u32,
+    /// Williams: nearest (one texel; the default), pcf (percentage-closer filtering over
+    /// --pcf-size² texels; the default when --pcf-size is given), or soft-edge (Shastry's
+    /// "Soft-Edged Shadows": PCF into a screen buffer, then a 15-tap Gaussian blur).
+    #[arg(long, value_enum)]
+    shadow_filter: Option<FilterArg>,
+    /// Williams: the PCF kernel's side in texels (odd; 3, Shastry's kernel, when not given).
+    #[arg(long)]
+    pcf_size: Option<u32>,
     /// Williams: leave polygons facing the light out of the depth map (the "Special Effect" notes).
     #[arg(long)]
     cull_front: bool,
@@ -192,10 +193,13 @@ impl ShadowArgs {
 
     /// `method` with the settings these flags give it (each flag sets its own method's).
     fn configure(&self, method: ShadowMethod) -> ShadowMethod {
-        let filter = match self.shadow_filter {
+        let kernel = self.pcf_size.unwrap_or(3);
+        let named =
+            self.shadow_filter.unwrap_or(if self.pcf_size.is_some() { FilterArg::Pcf } else { FilterArg::Nearest });
+        let filter = match named {
             FilterArg::Nearest => ShadowFilter::Nearest,
-            FilterArg::Pcf => ShadowFilter::Pcf(self.pcf_size),
-            FilterArg::SoftEdge => ShadowFilter::SoftEdge(self.pcf_size),
+            FilterArg::Pcf => ShadowFilter::Pcf(kernel),
+            FilterArg::SoftEdge => ShadowFilter::SoftEdge(kernel),
         };
         let volumes = VolumeOptions { counting: self.crow_count, silhouettes: !self.no_silhouettes };
         match method {

@@ -142,7 +142,10 @@ fn options_are_checked_wherever_they_are_used() {
     refused(&["trace", SMALL, "--line", "3", "--x", "5000"], "outside the image");
     // Williams' options: the same checks from render, trace and compare.
     let w = ["--shadows", "williams"];
-    refused(&[&["render", SMALL, "-o", "/dev/null", "--map-size", "2"][..], &w].concat(), "wider than the 2x2 map");
+    refused(
+        &[&["render", SMALL, "-o", "/dev/null", "--map-size", "2", "--shadow-filter", "pcf"][..], &w].concat(),
+        "wider than the 2x2 map",
+    );
     refused(&[&["render", SMALL, "-o", "/dev/null", "--map-size", "4", "--pcf-size", "5"][..], &w].concat(), "wider");
     refused(&[&["trace", SMALL, "--line", "3", "--map-size", "0"][..], &w].concat(), "map size 0");
     refused(&[&["trace", SMALL, "--line", "3", "--pcf-size", "2"][..], &w].concat(), "kernel size 2");

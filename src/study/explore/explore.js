@@ -451,7 +451,7 @@ function extra(d) {
   }
   if (detail.kind === "texels") {
     const inside = detail.texels.filter((t) => t.map !== null);
-    return `A ${detail.size}² map, ${detail.kernel}×${detail.kernel} texels compared per pixel. ` +
+    return `A ${detail.size}² map, ${detail.kernel === 1 ? "one texel" : `${detail.kernel}×${detail.kernel} texels`} compared per pixel. ` +
       `Below: the nearness the map holds at each pixel's texel (dots) and the pixel's own, with the ` +
       `bias (line); where the map holds more, the texel hides the point. ${inside.length} of ` +
       `${detail.texels.length} pixels fall on drawn texels. Right: their path across the map.`;
