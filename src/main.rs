@@ -257,7 +257,8 @@ struct RenderArgs {
     /// counters in false colour: depth_complexity.png, span_splits.png, shadow_tests.png.
     #[arg(long, value_name = "DIR")]
     aov: Option<PathBuf>,
-    /// Print the counters and times as one JSON object on standard output.
+    /// Print the counters and times as one JSON object on standard output (for williams,
+    /// with `map_errors`: its wrong interior pixels by cause, against ray-cast; two more renders).
     #[arg(long)]
     stats: bool,
     /// Encode the image with this display gamma (0.1 to 10, for example 2.2); default:
@@ -607,10 +608,34 @@ fn render_command(a: RenderArgs) -> umbra::Result<()> {
     }
     say(&format!("wrote {wrote}"))?;
     if a.stats {
-        let json = serde_json::to_string(&out.stats).map_err(|e| Error::Internal(e.to_string()))?;
+        let internal = |e: serde_json::Error| Error::Internal(e.to_string());
+        let mut json = serde_json::to_value(&out.stats).map_err(internal)?;
+        if let Some(errors) = map_errors(&scene, &opts, &out.frame)? {
+            json["map_errors"] = serde_json::to_value(errors).map_err(internal)?;
+        }
         stdout(&format!("{json}\n"))?;
     }
     Ok(())
+}
+
+/// For a shadow map's frame, its wrong interior pixels by cause against the ray-cast
+/// reference (`umbra::study::map_errors`): two more renders, the reference and the same map
+/// without bias. `None` for other methods.
+fn map_errors(
+    scene: &umbra::Scene,
+    opts: &RenderOptions,
+    frame: &umbra::Frame,
+) -> umbra::Result<Option<umbra::study::map_errors::MapErrors>> {
+    use umbra::study::map_errors::{classify, without_bias};
+    let Some(unbiased) = without_bias(&opts.shadows) else { return Ok(None) };
+    let reference = RenderOptions {
+        visibility: umbra::VisibilityMethod::RayCast,
+        shadows: ShadowMethod::RayCast,
+        ..RenderOptions::default()
+    };
+    let reference = umbra::render(scene, &reference)?.frame;
+    let unbiased = umbra::render(scene, &RenderOptions { shadows: unbiased, ..opts.clone() })?.frame;
+    Ok(Some(classify(&reference, frame, &unbiased)))
 }
 
 /// `umbra compare`: every method against the ray-cast reference, as a report.

@@ -43,6 +43,31 @@ fn render_writes_image_aovs_and_stats() {
     assert!(!d.join("aov/light4.png").exists());
 }
 
+/// `--stats` with Williams' shadow maps gives the map's wrong pixels by cause
+/// (`umbra::study::map_errors`), and their sum is the wrong pixels `compare` counts; other
+/// stages have no such entry.
+#[test]
+fn stats_give_a_shadow_maps_errors_by_cause() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/lights.toml");
+    let stats = |shadows: &str| -> serde_json::Value {
+        let out = umbra().args(["render", scene, "-o", "/dev/null", "--stats", "--shadows", shadows]).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let w = &stats("williams")["map_errors"];
+    let count = |k: &str| w[k].as_u64().unwrap_or_else(|| panic!("{k} in {w}"));
+    assert!(count("detached") > 0 && count("aliasing") > 0, "{w}");
+    let sum: u64 = ["acne", "detached", "aliasing", "resolution"].iter().map(|k| count(k)).sum();
+    let s = umbra::Scene::load(scene).unwrap();
+    let go =
+        |v, m| umbra::render(&s, &umbra::RenderOptions { visibility: v, shadows: m, ..Default::default() }).unwrap();
+    let reference = go(umbra::VisibilityMethod::RayCast, umbra::ShadowMethod::RayCast).frame;
+    let got = go(umbra::VisibilityMethod::Scanline, umbra::ShadowMethod::Williams(Default::default())).frame;
+    let (_, wrong, _) = umbra::study::compare::diff(&reference, &got);
+    assert_eq!(sum, wrong as u64, "every wrong interior pixel has one cause here (none sees another face)");
+    assert!(stats("bouknight-kelley").get("map_errors").is_none());
+}
+
 #[test]
 fn bad_input_is_one_line_and_non_zero() {
     let d = tmp("bad");
