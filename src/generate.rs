@@ -126,6 +126,71 @@ pub fn stacked_quads(d: u32, width: u32, height: u32) -> Result<Scene> {
     )
 }
 
+/// A geodesic sphere: an icosahedron whose triangles are split in four `levels` times, the
+/// new corners pushed out onto the sphere (no two neighbours are coplanar); closed, wound
+/// outward. Level 0 is the icosahedron.
+pub fn geodesic_sphere(centre: DVec3, r: f64, levels: u32) -> Mesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut corners: Vec<DVec3> = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
+    .collect();
+    let mut faces: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut middles = std::collections::HashMap::new();
+        let mut middle = |a: usize, b: usize, corners: &mut Vec<DVec3>| {
+            *middles.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                corners.push(((corners[a] + corners[b]) / 2.0).normalize());
+                corners.len() - 1
+            })
+        };
+        faces = faces
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                let (ab, bc, ca) = (middle(a, b, &mut corners), middle(b, c, &mut corners), middle(c, a, &mut corners));
+                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    let polygons: Vec<Vec<DVec3>> =
+        faces.iter().map(|f| f.iter().map(|&k| centre + r * corners[k]).collect()).collect();
+    Mesh::from_polygons(&polygons)
+}
+
 /// A UV sphere of radius `r` at `c` with about `triangles` triangles (at least 2 stacks).
 pub fn sphere_mesh(c: DVec3, r: f64, triangles: u32) -> Mesh {
     let stacks = ((triangles as f64 / 4.0).sqrt().round() as u32).max(2);
@@ -278,8 +343,11 @@ pub fn adversarial(seed: u64, opts: RandomOptions) -> Result<Scene> {
     let keep = open_box.faces.len() - if open_box.faces.len() == 12 { 2 } else { 1 };
     open_box.faces.truncate(keep);
     add(open_box, true);
-    let inward = rng.gen_bool(0.5);
-    add(icosahedron(ico_at, rng.gen_range(0.3..0.8), inward), rng.gen_bool(0.5));
+    let mut ico = geodesic_sphere(ico_at, rng.gen_range(0.3..0.8), 0);
+    if rng.gen_bool(0.5) {
+        ico.faces.iter_mut().for_each(|f| f.vertices.reverse());
+    }
+    add(ico, rng.gen_bool(0.5));
     let quads: Vec<Vec<DVec3>> = (0..3).map(|_| bumpy_quad(&mut rng, quad_at)).collect();
     add(Mesh::from_polygons(&quads), true);
     lights.push(Light {
@@ -339,61 +407,6 @@ fn bumpy_quad(rng: &mut ChaCha8Rng, c: DVec3) -> Vec<DVec3> {
         o + DVec3::new(s, 0.0, s) + j() * 0.2,
         o + DVec3::new(0.0, 0.0, s) + j() * 0.2,
     ]
-}
-
-/// A closed icosahedron of radius `r` at `c`, wound outward, or inward when `inward`.
-fn icosahedron(c: DVec3, r: f64, inward: bool) -> Mesh {
-    let g = (1.0 + 5f64.sqrt()) / 2.0;
-    let v: Vec<DVec3> = [
-        (-1.0, g, 0.0),
-        (1.0, g, 0.0),
-        (-1.0, -g, 0.0),
-        (1.0, -g, 0.0),
-        (0.0, -1.0, g),
-        (0.0, 1.0, g),
-        (0.0, -1.0, -g),
-        (0.0, 1.0, -g),
-        (g, 0.0, -1.0),
-        (g, 0.0, 1.0),
-        (-g, 0.0, -1.0),
-        (-g, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| c + DVec3::new(x, y, z).normalize() * r)
-    .collect();
-    const F: [[usize; 3]; 20] = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let faces: Vec<Vec<DVec3>> = F
-        .iter()
-        .map(|f| {
-            let mut t = vec![v[f[0]], v[f[1]], v[f[2]]];
-            if inward {
-                t.reverse();
-            }
-            t
-        })
-        .collect();
-    Mesh::from_polygons(&faces)
 }
 
 /// One random polygon of [`random`]: convex, or a star (concave), in a random orientation;

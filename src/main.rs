@@ -619,23 +619,22 @@ fn render_command(a: RenderArgs) -> umbra::Result<()> {
 }
 
 /// For a shadow map's frame, its wrong interior pixels by cause against the ray-cast
-/// reference (`umbra::study::map_errors`): two more renders, the reference and the same map
-/// without bias. `None` for other methods.
+/// reference (`umbra::study::map_errors`); `None` for other methods.
 fn map_errors(
     scene: &umbra::Scene,
     opts: &RenderOptions,
     frame: &umbra::Frame,
 ) -> umbra::Result<Option<umbra::study::map_errors::MapErrors>> {
-    use umbra::study::map_errors::{classify, without_bias};
-    let Some(unbiased) = without_bias(&opts.shadows) else { return Ok(None) };
+    if umbra::study::map_errors::without_bias(&opts.shadows).is_none() {
+        return Ok(None);
+    }
     let reference = RenderOptions {
         visibility: umbra::VisibilityMethod::RayCast,
         shadows: ShadowMethod::RayCast,
         ..RenderOptions::default()
     };
     let reference = umbra::render(scene, &reference)?.frame;
-    let unbiased = umbra::render(scene, &RenderOptions { shadows: unbiased, ..opts.clone() })?.frame;
-    Ok(Some(classify(&reference, frame, &unbiased)))
+    umbra::study::map_errors::measure(scene, opts, frame, &reference)
 }
 
 /// `umbra compare`: every method against the ray-cast reference, as a report.

@@ -173,7 +173,7 @@ pub fn compare(
                 None => MethodResult::not_run(v, s, status),
                 Some(m) => {
                     let mut r = MethodResult::measured(v, s, status, &m, &reference, |img, file| save(img, file))?;
-                    r.map_errors = map_errors(scene, v, s, &reference, &m.last.frame)?;
+                    r.map_errors = super::map_errors::measure(scene, &ropts, &m.last.frame, &reference)?;
                     r
                 }
             });
@@ -193,20 +193,6 @@ pub fn compare(
     };
     write_files(&report, &opts.out)?;
     Ok(report)
-}
-
-/// A shadow map's wrong pixels by cause: the frame `got` of method `s` behind `v` against
-/// `reference`, with the same map rendered once more without bias; `None` for other methods.
-fn map_errors(
-    scene: &Scene,
-    v: VisibilityMethod,
-    s: &ShadowMethod,
-    reference: &Frame,
-    got: &Frame,
-) -> Result<Option<super::map_errors::MapErrors>> {
-    let Some(unbiased) = super::map_errors::without_bias(s) else { return Ok(None) };
-    let unbiased = render(scene, &RenderOptions { visibility: v, shadows: unbiased, ..RenderOptions::default() })?;
-    Ok(Some(super::map_errors::classify(reference, got, &unbiased.frame)))
 }
 
 impl MethodResult {

@@ -19,7 +19,10 @@
 //! - **resolution**: the rest, lighter than the exact answer with no edge near: the map lacks
 //!   the caster at that texel (a caster smaller than a texel, lost between texel centres).
 
+use crate::error::Result;
 use crate::frame::Frame;
+use crate::render::{render, RenderOptions};
+use crate::scene::Scene;
 use crate::shadow::{ShadowMethod, WilliamsOptions};
 use serde::Serialize;
 
@@ -60,6 +63,15 @@ pub fn without_bias(method: &ShadowMethod) -> Option<ShadowMethod> {
         })),
         _ => None,
     }
+}
+
+/// The wrong interior pixels of `got` by cause, where `got` is the frame `opts` rendered of
+/// `scene` with a shadow map and `reference` the exact frame: renders the same map once more
+/// without bias ([`without_bias`]) and [`classify`]s. `None` for other shadow methods.
+pub fn measure(scene: &Scene, opts: &RenderOptions, got: &Frame, reference: &Frame) -> Result<Option<MapErrors>> {
+    let Some(unbiased) = without_bias(&opts.shadows) else { return Ok(None) };
+    let unbiased = render(scene, &RenderOptions { shadows: unbiased, ..opts.clone() })?;
+    Ok(Some(classify(reference, got, &unbiased.frame)))
 }
 
 /// Classifies the wrong interior pixels of `got` (a shadow map's frame) against `reference`

@@ -7,14 +7,19 @@ use umbra::{render, Frame, RenderOptions, Scene, ShadowMethod, VisibilityMethod}
 
 /// Every scene file in `scenes/`.
 pub fn scene_files() -> Vec<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    toml_files("scenes", 5)
+}
+
+/// The `.toml` files of folder `dir` (relative to the crate), sorted; at least `least`.
+pub fn toml_files(dir: &str, least: usize) -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(dir);
     let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("scenes/ exists")
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
         .collect();
     v.sort();
-    assert!(v.len() >= 5, "scenes/ should hold the example scenes");
+    assert!(v.len() >= least, "{} should hold at least {least} scenes: {v:?}", dir.display());
     v
 }
 

@@ -49,15 +49,7 @@ fn example_scenes() {
 /// meshes, self-intersecting polygons. Each once broke an exact stage.
 #[test]
 fn robustness_scenes() {
-    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/robustness");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    assert!(files.len() >= 8, "{files:?}");
-    for path in files {
+    for path in toml_files("tests/data/robustness", 8) {
         let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
         let (a, shadowed) = check(&scene, &path.display().to_string());
         assert!(shadowed > 100, "{}: {a:?}, only {shadowed} in shadow", path.display());
@@ -74,15 +66,7 @@ fn repro_scenes() {
     use VisibilityMethod::{RayCast, Scanline, ZBuffer};
     for (folder, visibility) in [("solids", &[Scanline, ZBuffer, RayCast][..]), ("awg-area", &[Scanline, ZBuffer][..])]
     {
-        let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(folder);
-        let mut files: Vec<_> = std::fs::read_dir(&dir)
-            .unwrap()
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-            .collect();
-        files.sort();
-        assert!(files.len() >= 8, "{files:?}");
-        for path in files {
+        for path in toml_files(&format!("tests/data/{folder}"), 8) {
             let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
             check_behind(&scene, &path.display().to_string(), visibility);
         }
@@ -692,71 +676,6 @@ fn merged_volumes_leave_out_closed_solids_turned_away() {
     assert!(merged * 10 < apart * 6 && merged * 10 > apart * 4, "{merged} caps merged, {apart} apart");
 }
 
-/// A geodesic sphere: an icosahedron whose triangles are split in four `levels` times, the
-/// new corners pushed out onto the sphere (no two neighbours are coplanar).
-fn geodesic_sphere(centre: glam::DVec3, r: f64, levels: u32) -> umbra::scene::Mesh {
-    use glam::DVec3;
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut corners: Vec<DVec3> = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
-    .collect();
-    let mut faces: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut middles = std::collections::HashMap::new();
-        let mut middle = |a: usize, b: usize, corners: &mut Vec<DVec3>| {
-            *middles.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                corners.push(((corners[a] + corners[b]) / 2.0).normalize());
-                corners.len() - 1
-            })
-        };
-        faces = faces
-            .iter()
-            .flat_map(|&[a, b, c]| {
-                let (ab, bc, ca) = (middle(a, b, &mut corners), middle(b, c, &mut corners), middle(c, a, &mut corners));
-                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
-            })
-            .collect();
-    }
-    let polygons: Vec<Vec<DVec3>> =
-        faces.iter().map(|f| f.iter().map(|&k| centre + r * corners[k]).collect()).collect();
-    umbra::scene::Mesh::from_polygons(&polygons)
-}
-
 /// Bouknight-Kelley drops a caster that shares corners with its receiver and otherwise lies
 /// behind it, even when rounding puts a shared corner a hair in front of the receiver's
 /// plane: on a sphere lit from outside, the prefilter keeps each polygon's neighbours, and
@@ -770,7 +689,7 @@ fn neighbours_behind_their_receiver_are_never_projected() {
         let scene = Scene::builder(camera)
             .material(Material::new("m"))
             .light(Light::point(glam::DVec3::new(-2.3, 5.1, 1.7)))
-            .object(Object::new(geodesic_sphere(centre, 0.77, levels)), "m")
+            .object(Object::new(umbra::generate::geodesic_sphere(centre, 0.77, levels)), "m")
             .build()
             .unwrap();
         let opts =
