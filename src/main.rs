@@ -96,12 +96,13 @@ struct AwgFlags {
 }
 
 impl AwgFlags {
-    /// Atherton-Weiler-Greenberg's settings from these flags.
-    fn options(&self) -> AthertonWeilerGreenbergOptions {
+    /// Atherton-Weiler-Greenberg's settings from these flags and `--no-solid-cull`.
+    fn options(&self, solid_cull: bool) -> AthertonWeilerGreenbergOptions {
         AthertonWeilerGreenbergOptions {
             convex_split: !self.no_convex_split,
             backgrounds: !self.no_backgrounds,
             lone_sheets: !self.no_lone_sheets,
+            solid_cull,
         }
     }
 }
@@ -111,8 +112,9 @@ struct ShadowArgs {
     /// Bouknight-Kelley: project every pair, without the sphere prefilter (to measure it).
     #[arg(long)]
     no_prefilter: bool,
-    /// Bouknight-Kelley: keep the polygons of closed solids that face away from the light
-    /// as casters, as the paper does (to measure what dropping them saves).
+    /// Bouknight-Kelley and Atherton-Weiler-Greenberg: keep the polygons of closed solids
+    /// that face away from the light (as casters; in AWG's light views), as the papers do (to
+    /// measure what dropping them saves).
     #[arg(long)]
     no_solid_cull: bool,
     #[command(flatten)]
@@ -207,7 +209,9 @@ impl ShadowArgs {
                 prefilter: !self.no_prefilter,
                 solid_cull: !self.no_solid_cull,
             }),
-            ShadowMethod::AthertonWeilerGreenberg(_) => ShadowMethod::AthertonWeilerGreenberg(self.awg.options()),
+            ShadowMethod::AthertonWeilerGreenberg(_) => {
+                ShadowMethod::AthertonWeilerGreenberg(self.awg.options(!self.no_solid_cull))
+            }
             ShadowMethod::Crow(_) => ShadowMethod::Crow(volumes),
             ShadowMethod::StencilVolume(_) => ShadowMethod::StencilVolume(volumes),
             ShadowMethod::Williams(_) => ShadowMethod::Williams(WilliamsOptions {
@@ -531,6 +535,10 @@ struct ExportArgs {
     /// Overwrite the OBJ file if it exists.
     #[arg(long)]
     force: bool,
+    /// Keep the polygons of closed solids that face away from the light in the light views,
+    /// as the paper does.
+    #[arg(long)]
+    no_solid_cull: bool,
     #[command(flatten)]
     awg: AwgFlags,
 }
@@ -767,7 +775,7 @@ fn export_shadows_command(e: ExportArgs) -> umbra::Result<()> {
     }
     refuse_overwrite(std::slice::from_ref(&e.output), e.force)?;
     let mut counters = umbra::Counters::default();
-    let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, e.awg.options(), &mut counters)?;
+    let db = umbra::shadow::ShadowDatabase::build(&scene, e.light, e.awg.options(!e.no_solid_cull), &mut counters)?;
     db.write_obj(&scene, &e.output)?;
     let polygons: usize = db.samples.iter().map(Vec::len).sum();
     say(&format!("wrote {}: {polygons} lit detail polygon(s) of light {}", e.output.display(), e.light))

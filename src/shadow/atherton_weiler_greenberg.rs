@@ -1193,7 +1193,7 @@ impl ShadowDatabase {
         let t = Instant::now();
         let mut done: Vec<(usize, Vec<DetailPolygon>, Pass1)> = Vec::new();
         for (s, sample) in l.samples().into_iter().enumerate() {
-            let unseen = unseen(scene, sample, extent, true);
+            let unseen = unseen(scene, sample, extent, options.solid_cull);
             let face = cube_faces(scene, sample, &unseen);
             let views: Vec<(Vec<DetailPolygon>, Pass1)> = LightView::views(sample)
                 .into_par_iter()

@@ -79,13 +79,19 @@ pub struct AthertonWeilerGreenbergOptions {
     /// another) on a grid, without testing pairs, and are wholly lit. `false` sorts them with
     /// the rest, as the paper does.
     pub lone_sheets: bool,
+    /// Leave out of each light view the polygons of closed solids that cast shadows and turn
+    /// away from the light (default true; ours, the solid cull of
+    /// `docs/algorithms/bouknight-kelley.md`): they are unlit and hide nothing the solid's
+    /// polygons turned to the light do not. `false` puts every polygon in the view, as the
+    /// paper does.
+    pub solid_cull: bool,
 }
 
 impl AthertonWeilerGreenbergOptions {
-    /// The paper's two passes, with convex pieces split by edges, and backgrounds and lone
-    /// sheets left out of the sort.
+    /// The paper's two passes, with convex pieces split by edges, and backgrounds, lone
+    /// sheets and solids' polygons turned from the light left out of the sort.
     pub const DEFAULT: AthertonWeilerGreenbergOptions =
-        AthertonWeilerGreenbergOptions { convex_split: true, backgrounds: true, lone_sheets: true };
+        AthertonWeilerGreenbergOptions { convex_split: true, backgrounds: true, lone_sheets: true, solid_cull: true };
 }
 
 impl Default for AthertonWeilerGreenbergOptions {

@@ -64,11 +64,12 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
         ),
         ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg(Default::default())),
         (
-            "atherton-weiler-greenberg --no-convex-split --no-backgrounds --no-lone-sheets".into(),
+            "atherton-weiler-greenberg --no-convex-split --no-backgrounds --no-lone-sheets --no-solid-cull".into(),
             ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions {
                 convex_split: false,
                 backgrounds: false,
                 lone_sheets: false,
+                solid_cull: false,
             }),
         ),
         ("crow zpass".into(), ShadowMethod::Crow(volumes(Counting::ZPass))),
