@@ -150,9 +150,10 @@ struct ShadowArgs {
     /// extrapolated to it.
     #[arg(long)]
     receiver_plane: bool,
-    /// Williams: nearest (one texel; the default), pcf (percentage-closer filtering over
-    /// --pcf-size² texels; the default when --pcf-size is given), or soft-edge (Shastry's
-    /// "Soft-Edged Shadows": PCF into a screen buffer, then a 15-tap Gaussian blur).
+    /// Williams: nearest (one texel; the default), pcf (percentage-closer filtering over a
+    /// regular box of --pcf-size² texels; the default when --pcf-size is given), stochastic
+    /// (Reeves, Salesin & Cook's: --pcf-size² jittered samples over the box), or soft-edge
+    /// (Shastry's "Soft-Edged Shadows": PCF into a screen buffer, then a 15-tap Gaussian blur).
     #[arg(long, value_enum)]
     shadow_filter: Option<FilterArg>,
     /// Williams: the PCF kernel's side in texels (odd; 3, Shastry's kernel, when not given).
@@ -201,6 +202,7 @@ impl ShadowArgs {
         let filter = match named {
             FilterArg::Nearest => ShadowFilter::Nearest,
             FilterArg::Pcf => ShadowFilter::Pcf(kernel),
+            FilterArg::Stochastic => ShadowFilter::Stochastic(kernel),
             FilterArg::SoftEdge => ShadowFilter::SoftEdge(kernel),
         };
         let volumes = VolumeOptions { counting: self.crow_count, silhouettes: !self.no_silhouettes };
@@ -467,8 +469,10 @@ fn open_browser(address: &str) {
 enum FilterArg {
     /// One texel.
     Nearest,
-    /// Percentage-closer filtering.
+    /// Percentage-closer filtering over a regular box of texels.
     Pcf,
+    /// Reeves, Salesin & Cook's percentage-closer filtering: jittered samples over the box.
+    Stochastic,
     /// PCF, then Shastry's screen-space blur.
     SoftEdge,
 }

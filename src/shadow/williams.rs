@@ -1,6 +1,7 @@
 //! Williams' two-pass z-buffer shadows (L. Williams, "Casting curved shadows on curved
 //! surfaces", SIGGRAPH 1978; the "Rendering 6: Shadow", "Special Effect" and "Árnyékolás" notes and Shastry's "Soft-Edged Shadows"), with percentage-closer filtering
-//! (Reeves, Salesin & Cook 1987) and the soft-edged screen-space blur of Shastry's "Soft-Edged Shadows".
+//! over a regular box of texels, Reeves, Salesin & Cook's stochastic percentage-closer
+//! filtering (SIGGRAPH 1987), and the soft-edged screen-space blur of Shastry's "Soft-Edged Shadows".
 //!
 //! **Pass 1** renders the depth of the shadow casters from each light sample with the same
 //! z-buffer loop as visibility (`raster::rasterize`): a perspective map aimed at
@@ -43,8 +44,14 @@ use wide::f32x4;
 pub enum ShadowFilter {
     /// One texel, one comparison.
     Nearest,
-    /// Percentage-closer filtering over N×N texels (N odd).
+    /// Percentage-closer filtering over a regular box of N×N texels (N odd): every texel of
+    /// the box compared once, the form GPUs give.
     Pcf(u32),
+    /// Reeves, Salesin & Cook's percentage-closer filtering as published (1987): N×N samples
+    /// jittered over the same N-texel box (one at a random place in each of its N×N cells),
+    /// each compared with the point's depth, the answers averaged. The random places follow
+    /// from the point's position in the map, so a frame is the same at every thread count.
+    Stochastic(u32),
     /// Shastry's "Soft-Edged Shadows": N×N PCF into a screen buffer, then the 15-tap separable Gaussian blur.
     SoftEdge(u32),
 }
@@ -113,7 +120,7 @@ impl WilliamsOptions {
         if !(1..=Self::MAX_MAP_SIZE).contains(&self.map_size) {
             return fail(format!("map size {} is not in 1..={}", self.map_size, Self::MAX_MAP_SIZE));
         }
-        if let ShadowFilter::Pcf(n) | ShadowFilter::SoftEdge(n) = self.filter {
+        if let ShadowFilter::Pcf(n) | ShadowFilter::SoftEdge(n) | ShadowFilter::Stochastic(n) = self.filter {
             if n.is_multiple_of(2) || n > Self::MAX_KERNEL {
                 return fail(format!("kernel size {n} is not odd and in 1..={}", Self::MAX_KERNEL));
             }
@@ -218,12 +225,22 @@ struct Bias {
     normal: DVec3,
     /// Compare each kernel texel with the receiver's plane extrapolated to it.
     receiver_plane: bool,
+    /// Reeves et al.'s jittered samples instead of the regular box.
+    stochastic: bool,
 }
 
 /// Texels added to each row of a map: rows a power of two apart would otherwise share
 /// cache sets, and a kernel walking down the map would evict its own rows. The extra
 /// columns hold what lies just beyond the map's edge, and are never read.
 const PAD: u32 = 16;
+
+/// A 64-bit mix (splitmix64's finaliser): the random places of
+/// [`DepthMap::filter_stochastic`]'s samples, from a point's position and a cell.
+fn mix(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
 
 /// One depth map: the nearness of the nearest caster per texel (as rasterised: `1/z` for a
 /// perspective map, `−depth` for an orthographic one; `−∞` where none was drawn).
@@ -298,6 +315,7 @@ impl DepthMap {
             self.locate(&lookup, b * BATCH, out.len(), r, batch);
             match lookup.receiver_plane {
                 Some(gradient) => self.filter_receiver_plane(batch, r, gradient, out),
+                None if bias.stochastic => self.filter_stochastic(batch, r, out),
                 None => self.filter(batch, r, out),
             }
         }
@@ -416,6 +434,41 @@ impl DepthMap {
                     let receiver = t + a * (tx as f32 + 0.5 - x) + b * (ty as f32 + 0.5 - y);
                     lit += u32::from(!inside || self.nearness[ty as usize * stride + tx as usize] <= receiver);
                 }
+            }
+            *o = lit as f32 * share;
+        }
+    }
+
+    /// Reeves, Salesin & Cook (1987): the `(2r+1)`-texel box around each located point cut
+    /// into `(2r+1)²` cells, one sample at a random place in each (jittered sampling), each
+    /// sample's texel compared with the point's threshold, the answers averaged. Texels outside
+    /// the map count as lit. The paper's box is the pixel's footprint in the map; this stage
+    /// uses the fixed box of the regular filter (ours), so the two differ only in where the
+    /// samples fall.
+    fn filter_stochastic(&self, batch: &Located, r: usize, out: &mut [f32]) {
+        let (n, stride) = (self.size as i64, (self.size + PAD) as usize);
+        let width = 2 * r + 1;
+        let share = 1.0 / (width * width) as f32;
+        let len = out.len();
+        let (xs, ys) = (&batch.x.as_flattened()[..len], &batch.y.as_flattened()[..len]);
+        let thresholds = &batch.threshold.as_flattened()[..len];
+        for (k, o) in out.iter_mut().enumerate() {
+            let (x, y, t) = (xs[k], ys[k], thresholds[k]);
+            if !(x.is_finite() && y.is_finite()) {
+                *o = 1.0; // behind the light, or within the bias of it
+                continue;
+            }
+            let seed = (u64::from(x.to_bits()) << 32) | u64::from(y.to_bits());
+            let (x0, y0) = (x - width as f32 / 2.0, y - width as f32 / 2.0);
+            let mut lit = 0u32;
+            for cell in 0..width * width {
+                let jitter = mix(seed ^ (cell as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+                let (jx, jy) =
+                    ((jitter >> 40) as f32 / (1u64 << 24) as f32, (jitter & 0xff_ffff) as f32 / (1u64 << 24) as f32);
+                let (sx, sy) = (x0 + (cell % width) as f32 + jx, y0 + (cell / width) as f32 + jy);
+                let (tx, ty) = (sx.floor() as i64, sy.floor() as i64);
+                let inside = (0..n).contains(&tx) && (0..n).contains(&ty);
+                lit += u32::from(!inside || self.nearness[ty as usize * stride + tx as usize] <= t);
             }
             *o = lit as f32 * share;
         }
@@ -758,7 +811,9 @@ impl<'a> Williams<'a> {
     fn kernel_radius(&self) -> usize {
         match self.options.filter {
             ShadowFilter::Nearest => 0,
-            ShadowFilter::Pcf(n) | ShadowFilter::SoftEdge(n) => (n.max(1) | 1) as usize / 2,
+            ShadowFilter::Pcf(n) | ShadowFilter::SoftEdge(n) | ShadowFilter::Stochastic(n) => {
+                (n.max(1) | 1) as usize / 2
+            }
         }
     }
 
@@ -799,6 +854,7 @@ impl<'a> Williams<'a> {
             offset: self.options.normal_offset,
             normal,
             receiver_plane: self.options.receiver_plane,
+            stochastic: matches!(self.options.filter, ShadowFilter::Stochastic(_)),
         };
         (h0 * flip, step * flip, bias)
     }
