@@ -125,7 +125,8 @@ pub enum SpecularModel {
     /// Phong: `(R.V)^n`.
     #[default]
     Phong,
-    /// Blinn: `(N.H)^n`.
+    /// Blinn-Phong: `(N.H)^n`, the halfway-vector highlight of Blinn (1977), not his microfacet
+    /// model (`docs/shading.md`, "Against the notes"); `"blinn"` in a scene file.
     Blinn,
     /// Cook-Torrance microfacet model.
     CookTorrance,
