@@ -1,4 +1,5 @@
-//! Renders a scene with every exact shadow stage behind both visibility stages and counts,
+//! Renders a scene with every exact shadow stage (and the paper paths) behind both visibility
+//! stages and counts,
 //! at every pixel, where each differs from the ray-cast reference (face id or lit fraction).
 //!
 //! `cargo run --release --example exactness -- scene.toml [more.toml ...]`
@@ -25,6 +26,10 @@ fn main() {
             ("crow-zfail", ShadowMethod::Crow(volumes(Counting::ZFail))),
             ("stencil-zpass", ShadowMethod::StencilVolume(volumes(Counting::ZPass))),
             ("stencil-zfail", ShadowMethod::StencilVolume(volumes(Counting::ZFail))),
+            ("bk-paper", ShadowMethod::DEFAULT.as_published()),
+            ("awg-paper", ShadowMethod::AthertonWeilerGreenberg(Default::default()).as_published()),
+            ("crow-1977", ShadowMethod::Crow(volumes(Counting::ZPass)).as_published()),
+            ("crow-zfail-uncut", ShadowMethod::Crow(volumes(Counting::ZFail)).as_published()),
         ];
         for vis in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
             for (name, s) in &stages {

@@ -11,7 +11,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use umbra::shadow::Counting;
 use umbra::shadow::{
-    AthertonWeilerGreenbergOptions, BouknightKelleyOptions, ShadowFilter, VolumeOptions, WilliamsOptions,
+    AthertonWeilerGreenbergOptions, BouknightKelleyOptions, Construction, ShadowFilter, VolumeOptions, WilliamsOptions,
 };
 use umbra::study::compare::{compare, CompareOptions};
 use umbra::study::scale::{scale, ScaleOptions, Sweep};
@@ -93,6 +93,18 @@ struct AwgFlags {
     /// lighting them whole.
     #[arg(long)]
     no_lone_sheets: bool,
+    /// Atherton-Weiler-Greenberg: sort each light view whole, as the paper does, instead of
+    /// cutting it into regions of at most 128 casters sorted apart.
+    #[arg(long)]
+    no_tiling: bool,
+    /// Atherton-Weiler-Greenberg: map every polygon into all six views of the cube around a
+    /// point light, instead of a polygon wholly inside one face into that face alone.
+    #[arg(long)]
+    no_face_binning: bool,
+    /// Atherton-Weiler-Greenberg: hand each front polygon every piece still in the sort, as
+    /// the paper's clipper takes the whole list, instead of those a grid finds near it.
+    #[arg(long)]
+    no_sort_grid: bool,
 }
 
 impl AwgFlags {
@@ -103,15 +115,40 @@ impl AwgFlags {
             backgrounds: !self.no_backgrounds,
             lone_sheets: !self.no_lone_sheets,
             solid_cull,
+            tiling: !self.no_tiling,
+            face_binning: !self.no_face_binning,
+            sort_grid: !self.no_sort_grid,
         }
     }
 }
 
 #[derive(clap::Args)]
 struct ShadowArgs {
+    /// Run Bouknight-Kelley, Atherton-Weiler-Greenberg, Crow and stencil-volume as their
+    /// papers publish them, every step of ours off (`ShadowMethod::as_published`; each step
+    /// and its switch are in docs/algorithms/). Crow's 1977 construction is exact only where
+    /// its preconditions hold.
+    #[arg(long)]
+    paper: bool,
     /// Bouknight-Kelley: project every pair, without the sphere prefilter (to measure it).
     #[arg(long)]
     no_prefilter: bool,
+    /// Bouknight-Kelley: compare the sphere extents of every ordered pair, as the paper does,
+    /// instead of finding the overlapping ones in a grid (ours).
+    #[arg(long)]
+    no_sphere_grid: bool,
+    /// Bouknight-Kelley: make every polygon the light faces a receiver, as the paper does,
+    /// not only those seen at some pixel (ours).
+    #[arg(long)]
+    all_receivers: bool,
+    /// Bouknight-Kelley: project casters wholly behind the receiver and find the projection
+    /// empty, as the paper does, instead of dropping them first (ours).
+    #[arg(long)]
+    no_drop_behind: bool,
+    /// Bouknight-Kelley: project casters outside a triangle receiver's wedge from the light,
+    /// as the paper does, instead of dropping them first (ours).
+    #[arg(long)]
+    no_wedge: bool,
     /// Bouknight-Kelley and Atherton-Weiler-Greenberg: keep the polygons of closed solids
     /// that face away from the light (as casters; in AWG's light views), as the papers do (to
     /// measure what dropping them saves).
@@ -124,12 +161,21 @@ struct ShadowArgs {
     /// eye is in shadow).
     #[arg(long, default_value = "zpass", value_parser = parse::<Counting>)]
     crow_count: Counting,
-    /// Crow and stencil-volume: give every polygon its own volume instead of merging the
-    /// sides that neighbouring polygons share and leaving out closed solids' polygons turned
-    /// away from the light (to measure what that saves: merged, only silhouette and boundary
-    /// edges keep sides).
+    /// Crow and stencil-volume: how the volumes are built: merged (Bergeron 1986, the sides
+    /// neighbouring polygons share merged; the default), per-polygon (every polygon its own
+    /// volume, to measure what merging saves), or crow-1977 (Crow's one volume per object on
+    /// its contour edges, with one starting count for the image; the paper's, wrong where
+    /// its preconditions fail).
+    #[arg(long, default_value = "merged", value_parser = parse::<Construction>)]
+    volumes: Construction,
+    /// Crow and stencil-volume: give every polygon its own volume (`--volumes per-polygon`).
     #[arg(long)]
     no_silhouettes: bool,
+    /// Crow and stencil-volume: extrude the volumes to infinity uncut, as the papers do;
+    /// z-fail's are then clipped by the camera's far plane where the scene has one (ours:
+    /// cut to where a count reaches, z-fail closed beyond the scene).
+    #[arg(long)]
+    no_sight_cuts: bool,
     /// Williams: texels along each side of a shadow map.
     #[arg(long, default_value_t = 2048)]
     map_size: u32,
@@ -194,8 +240,19 @@ impl ShadowArgs {
         Ok(scene)
     }
 
-    /// `method` with the settings these flags give it (each flag sets its own method's).
+    /// `method` with the settings these flags give it (each flag sets its own method's), as
+    /// published with `--paper`.
     fn configure(&self, method: ShadowMethod) -> ShadowMethod {
+        let method = self.engineered(method);
+        if self.paper {
+            method.as_published()
+        } else {
+            method
+        }
+    }
+
+    /// `method` with the settings these flags give it, `--paper` aside.
+    fn engineered(&self, method: ShadowMethod) -> ShadowMethod {
         let kernel = self.pcf_size.unwrap_or(3);
         let named =
             self.shadow_filter.unwrap_or(if self.pcf_size.is_some() { FilterArg::Pcf } else { FilterArg::Nearest });
@@ -205,10 +262,15 @@ impl ShadowArgs {
             FilterArg::Stochastic => ShadowFilter::Stochastic(kernel),
             FilterArg::SoftEdge => ShadowFilter::SoftEdge(kernel),
         };
-        let volumes = VolumeOptions { counting: self.crow_count, silhouettes: !self.no_silhouettes };
+        let construction = if self.no_silhouettes { Construction::PerPolygon } else { self.volumes };
+        let volumes = VolumeOptions { counting: self.crow_count, construction, sight_cuts: !self.no_sight_cuts };
         match method {
             ShadowMethod::BouknightKelley(_) => ShadowMethod::BouknightKelley(BouknightKelleyOptions {
                 prefilter: !self.no_prefilter,
+                sphere_grid: !self.no_sphere_grid,
+                seen_receivers: !self.all_receivers,
+                drop_behind: !self.no_drop_behind,
+                wedge: !self.no_wedge,
                 solid_cull: !self.no_solid_cull,
             }),
             ShadowMethod::AthertonWeilerGreenberg(_) => {
@@ -230,9 +292,17 @@ impl ShadowArgs {
         }
     }
 
-    /// Every method of `methods` configured by these flags.
-    fn configure_all(&self, methods: Vec<ShadowMethod>) -> Vec<ShadowMethod> {
-        methods.into_iter().map(|m| self.configure(m)).collect()
+    /// Every method of `methods` configured by these flags; with `--paper`, each stage that
+    /// has a paper path twice, engineered and then as published, for the commands that
+    /// measure methods side by side.
+    fn configure_beside(&self, methods: Vec<ShadowMethod>) -> Vec<ShadowMethod> {
+        let mut out = Vec::new();
+        for m in methods.into_iter().map(|m| self.engineered(m)) {
+            let paper = (self.paper && m.has_paper_path()).then(|| m.as_published());
+            out.push(m);
+            out.extend(paper);
+        }
+        out
     }
 }
 
@@ -422,6 +492,10 @@ struct ExploreArgs {
     /// Write into an --export folder that has files already.
     #[arg(long)]
     force: bool,
+    /// Start the page with the stages as their papers publish them (the page's "as
+    /// published" box; the live page only).
+    #[arg(long)]
+    paper: bool,
 }
 
 #[cfg(feature = "explore")]
@@ -439,7 +513,7 @@ fn explore(a: ExploreArgs) -> umbra::Result<()> {
     use umbra::study::explore::{export, serve, Explorer};
     let scene = Scene::load(&a.scene)?;
     let name = a.scene.file_name().map_or_else(|| a.scene.display().to_string(), |n| n.to_string_lossy().into_owned());
-    let explorer = Explorer::new(scene, name);
+    let explorer = Explorer::new(scene, name).with_paper(a.paper);
     if let Some(dir) = &a.export {
         let used = std::fs::read_dir(dir).map(|mut d| d.next().is_some()).unwrap_or(false);
         if used && !a.force {
@@ -655,7 +729,7 @@ fn compare_command(a: CompareArgs) -> umbra::Result<()> {
     let d = CompareOptions::default();
     let opts = CompareOptions {
         visibility: if a.visibility.is_empty() { d.visibility } else { a.visibility },
-        shadows: a.shadow.configure_all(if a.shadows.is_empty() { d.shadows } else { a.shadows }),
+        shadows: a.shadow.configure_beside(if a.shadows.is_empty() { d.shadows } else { a.shadows }),
         warmup: a.warmup,
         runs: a.runs,
         out: a.out.clone(),
@@ -667,7 +741,7 @@ fn compare_command(a: CompareArgs) -> umbra::Result<()> {
     let mut table = String::new();
     for r in &report.results {
         table += &format!(
-            "{:>9} + {:<26} {:>9.1} ms ({:.1}–{:.1})  {:>8} / {:<8} wrong  {}\n",
+            "{:>9} + {:<34} {:>9.1} ms ({:.1}–{:.1})  {:>8} / {:<8} wrong  {}\n",
             r.visibility,
             r.shadows,
             r.time.median_ms,
@@ -679,7 +753,7 @@ fn compare_command(a: CompareArgs) -> umbra::Result<()> {
         );
         if let Some(c) = r.map_errors {
             table += &format!(
-                "{:>38} acne {}, detached {}, aliasing {}, resolution {}\n",
+                "{:>46} acne {}, detached {}, aliasing {}, resolution {}\n",
                 "by cause:", c.acne, c.detached, c.aliasing, c.resolution
             );
         }
@@ -693,7 +767,7 @@ fn bench_command(a: BenchArgs) -> umbra::Result<()> {
     let scene = a.shadow.load(&a.scene)?;
     let opts = umbra::study::bench::BenchOptions {
         visibility: a.visibility,
-        shadows: a.shadow.configure_all(a.shadows),
+        shadows: a.shadow.configure_beside(a.shadows),
         warmup: a.warmup,
         runs: a.runs,
         back_face_cull: !a.no_back_face_cull,
@@ -726,7 +800,10 @@ fn scale_command(a: ScaleArgs) -> umbra::Result<()> {
     let methods = if a.methods.is_empty() {
         vec![(VisibilityMethod::Scanline, ShadowMethod::None), (VisibilityMethod::ZBuffer, ShadowMethod::None)]
     } else {
-        a.methods.into_iter().map(|(v, s)| (v, a.shadow.configure(s))).collect()
+        a.methods
+            .into_iter()
+            .flat_map(|(v, s)| a.shadow.configure_beside(vec![s]).into_iter().map(move |s| (v, s)))
+            .collect()
     };
     let opts = ScaleOptions {
         sweep: a.sweep,
@@ -743,7 +820,7 @@ fn scale_command(a: ScaleArgs) -> umbra::Result<()> {
     let mut table = String::new();
     for p in scale(&opts)? {
         table += &format!(
-            "{:>10} {:>9} + {:<26} {:>9.1} ms ({:.1}–{:.1})  {}\n",
+            "{:>10} {:>9} + {:<34} {:>9.1} ms ({:.1}–{:.1})  {}\n",
             p.value, p.visibility, p.shadows, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
         );
     }

@@ -248,7 +248,7 @@ fn frame_pass(
     check_frame_memory(scene, opts)?;
     let mut stats = Stats {
         visibility: opts.visibility.name().into(),
-        shadows: opts.shadows.name().into(),
+        shadows: opts.shadows.label(),
         width: scene.camera.width,
         height: scene.camera.height,
         polygons: scene.polygons.len(),

@@ -111,6 +111,10 @@ struct Pass1 {
     backgrounds: bool,
     /// Take lone sheets out of the sort ([`AthertonWeilerGreenbergOptions::lone_sheets`]).
     lone_sheets: bool,
+    /// Cut the view into regions ([`AthertonWeilerGreenbergOptions::tiling`]).
+    tiling: bool,
+    /// Find overlapping pieces in a grid ([`AthertonWeilerGreenbergOptions::sort_grid`]).
+    sort_grid: bool,
     backgrounds_found: u64,
     lone: u64,
     fragments: u64,
@@ -126,6 +130,8 @@ impl Pass1 {
             convex_split: options.convex_split,
             backgrounds: options.backgrounds,
             lone_sheets: options.lone_sheets,
+            tiling: options.tiling,
+            sort_grid: options.sort_grid,
             ..Default::default()
         }
     }
@@ -333,7 +339,7 @@ fn cut_all(
             })
             .collect();
     }
-    let flags = Pass1 { convex_split: stats.convex_split, ..Default::default() };
+    let flags = Pass1 { convex_split: stats.convex_split, sort_grid: stats.sort_grid, ..Default::default() };
     let done: Vec<(u32, Piece, Option<Sorted>, Pass1)> = taken
         .into_par_iter()
         .with_max_len(CUTS_PER_PIECE)
@@ -433,7 +439,7 @@ impl Sorting {
                 && (splits(p, front, stats) || !stats.convex_split || !regions_apart(&p.region, &front.region))
         };
         let cells = self.cells(front.bounds).collect::<smallvec::SmallVec<[usize; 8]>>();
-        if cells.len() * 4 >= self.grid.len() {
+        if !stats.sort_grid || cells.len() * 4 >= self.grid.len() {
             // A front polygon over much of the grid (a stack of large polygons): the pieces
             // are fewer to read than the cells' lists.
             let live = self.arena.iter().enumerate().filter_map(|(q, p)| Some((q as u32, p.as_ref()?)));
@@ -798,7 +804,7 @@ fn lit_in_view(
     // Cutting may copy pieces that straddle a border: at most three more copies in all than
     // there are pieces, however the cuts fall.
     let copies = 3 * (casters.len() + others.len());
-    let lists = regions(casters, others, rect, copies);
+    let lists = if stats.tiling { regions(casters, others, rect, copies) } else { vec![(casters, others)] };
     stats.tiles += lists.len() as u64;
     // Step 1(c) too, region by region: the lit pieces back onto their planes (a whole
     // polygon as it is).
@@ -816,7 +822,12 @@ fn lit_in_view(
         .with_max_len(1)
         .map(|(casters, others)| {
             let convex_split = stats.convex_split && !stacked(&casters, &others);
-            let mut st = Pass1 { convex_split, backgrounds: stats.backgrounds, ..Default::default() };
+            let mut st = Pass1 {
+                convex_split,
+                backgrounds: stats.backgrounds,
+                sort_grid: stats.sort_grid,
+                ..Default::default()
+            };
             let mut cover = Vec::new();
             let lit = lit_pieces(scene, casters, others, keep_cover.then_some(&mut cover), &mut st)?;
             Ok((lit.into_iter().map(unmap).collect(), cover, st))
@@ -1201,7 +1212,8 @@ impl ShadowDatabase {
                 .map(|(f, view)| {
                     let mut stats = Pass1::new(options);
                     // A polygon wholly inside one cube face is mapped into that face alone.
-                    let unseen = |i: usize| unseen[i] || matches!(face.get(i), Some(&Some(g)) if g != f as u8);
+                    let elsewhere = |i: usize| matches!(face.get(i), Some(&Some(g)) if g != f as u8);
+                    let unseen = |i: usize| unseen[i] || (options.face_binning && elsewhere(i));
                     let lit = lit_in_view(scene, unseen, view, extent, &mut stats).map_err(clip_error)?;
                     Ok((lit, stats))
                 })

@@ -94,9 +94,10 @@ fn shadow_polygons(
     let scene = ctx.scene;
     let n = scene.polygons.len();
     counters.add("pairs", (n as u64) * (n as u64).saturating_sub(1));
+    let seen = |i: usize| !options.seen_receivers || ctx.visible[i];
     let receivers: Vec<u32> = (0..n as u32)
         .into_par_iter()
-        .filter(|&i| ctx.visible[i as usize] && sample.on_seen_side(&scene.polygons[i as usize].plane, ctx.view.eye))
+        .filter(|&i| seen(i as usize) && sample.on_seen_side(&scene.polygons[i as usize].plane, ctx.view.eye))
         .collect();
     let casting = |i: usize| scene.casts_shadows(i) && !edge_on(scene, i, sample, ctx.extent);
     let closed = scene.closed_from(sample);
@@ -112,7 +113,11 @@ fn shadow_polygons(
     counters.add("pairs_with_roles", receivers.len() as u64 * casters.len() as u64);
 
     let t = Instant::now();
-    let grid = options.prefilter.then(|| SphereGrid::new(scene, sample, &casters, &receivers));
+    let extents = options.prefilter.then(|| Extents::new(scene, sample, &casters, &receivers));
+    let (grid, extents) = match extents {
+        Some(e) if options.sphere_grid => (Some(SphereGrid::new(e, sample, &casters)), None),
+        e => (None, e),
+    };
     counters.add("prefilter_grid_us", t.elapsed().as_micros() as u64);
 
     // Receivers differ widely in cost, so the loop is cut into pieces of at most
@@ -133,13 +138,16 @@ fn shadow_polygons(
             },
             |(proj, stamp, scratch, ring, candidates), &b| {
                 let t = Instant::now();
-                match &grid {
-                    Some(g) => g.candidates(b, stamp, candidates),
-                    None => candidates.clone_from(&casters),
+                let mut tested = 0;
+                match (&grid, &extents) {
+                    (Some(g), _) => g.candidates(b, stamp, candidates),
+                    (None, Some(e)) => tested = e.every_pair(b, &casters, candidates),
+                    (None, None) => candidates.clone_from(&casters),
                 }
                 let prefilter_ns = t.elapsed().as_nanos() as u64;
                 let t = Instant::now();
-                let (mut tally, table, pairs) = project_onto(ctx, sample, b, candidates, proj, scratch, ring);
+                let (mut tally, table, pairs) = project_onto(ctx, options, sample, b, candidates, proj, scratch, ring);
+                tally.tested += tested;
                 tally.prefilter_ns += prefilter_ns;
                 tally.projection_ns += t.elapsed().as_nanos() as u64;
                 (tally, table, pairs)
@@ -150,9 +158,16 @@ fn shadow_polygons(
     let (overlay, total, kept_pairs) = merge(ctx, per_receiver);
     if options.prefilter {
         counters.add("pairs_kept_by_prefilter", total.kept);
+        if !options.sphere_grid {
+            counters.add("pairs_tested_by_prefilter", total.tested);
+        }
     }
-    counters.add("pairs_dropped_behind", total.behind);
-    counters.add("pairs_outside_receiver", total.outside);
+    if options.drop_behind {
+        counters.add("pairs_dropped_behind", total.behind);
+    }
+    if options.wedge {
+        counters.add("pairs_outside_receiver", total.outside);
+    }
     counters.add("projections_empty", total.empty);
     counters.add("shadow_polygons", overlay.len() as u64);
     counters.add("prefilter_cpu_us", total.prefilter_ns / 1000);
@@ -161,11 +176,13 @@ fn shadow_polygons(
 }
 
 /// Steps 2 and 3 for receiver `b`: each candidate caster (not a piece of `b`'s own face) is
-/// dropped when wholly behind `b` as the light sees it, else projected from the light onto
-/// `b`'s plane and into the image. Returns the tally, the shadow polygons' edge table, and
-/// (for traces) what became of each pair.
+/// projected from the light onto `b`'s plane and into the image, unless (ours, with their
+/// switches) it lies wholly behind `b` as the light sees it or outside `b`'s wedge. Returns
+/// the tally, the shadow polygons' edge table, and (for traces) what became of each pair.
+#[allow(clippy::too_many_arguments)]
 fn project_onto(
     ctx: &ShadowContext,
+    options: BouknightKelleyOptions,
     sample: LightSample,
     b: u32,
     candidates: &[u32],
@@ -181,7 +198,7 @@ fn project_onto(
     let side = light_side(&plane, sample);
     let b_verts = scene.verts(b as usize);
     let target = Target::new(plane, bounding_rectangle(b_verts, &plane), sample);
-    let wedge = Wedge::of(b_verts, sample, ctx.extent);
+    let wedge = if options.wedge { Wedge::of(b_verts, sample, ctx.extent) } else { None };
     for &a in candidates {
         if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
             continue;
@@ -191,7 +208,7 @@ fn project_onto(
             pairs.kept.push(a);
         }
         let a_verts = scene.verts(a as usize);
-        if a_verts.iter().all(|&v| plane.distance(v) * side <= 0.0 || b_verts.contains(&v)) {
+        if options.drop_behind && a_verts.iter().all(|&v| plane.distance(v) * side <= 0.0 || b_verts.contains(&v)) {
             tally.behind += 1;
             if record {
                 pairs.behind.push(a);
@@ -242,6 +259,7 @@ fn merge(
 /// What happened to one receiver's pairs.
 #[derive(Default)]
 struct Tally {
+    tested: u64,
     kept: u64,
     behind: u64,
     outside: u64,
@@ -252,6 +270,7 @@ struct Tally {
 
 impl Tally {
     fn add(&mut self, o: &Tally) {
+        self.tested += o.tested;
         self.kept += o.kept;
         self.behind += o.behind;
         self.outside += o.outside;
@@ -334,24 +353,16 @@ impl Extent {
     const NONE: Extent = Extent { boxes: [None, None], cone: Cone { axis: DVec3::Y, half: 0.0, cos: 1.0, sin: 0.0 } };
 }
 
-/// Step 2, the sphere prefilter: every polygon's extent on the sphere around the light (on
-/// the plane across a directional light), and a grid over the extents' domain (polar angle ×
-/// azimuth, or the plane's two axes) in which each caster is binned in every cell its extent
-/// touches.
-struct SphereGrid {
+/// Step 2, the sphere prefilter: every caster's and receiver's extent on the sphere around
+/// the light (on the plane across a directional light).
+struct Extents {
     /// Each polygon's extent: its boxes, and its cone.
     boxes: Vec<Boxes>,
     cones: Vec<Cone>,
-    domain: [f64; 4],
-    g: usize,
-    /// The casters binned in cell `k` (column-major, `c * g + r`) are
-    /// `binned[first[k]..first[k + 1]]`, in increasing order.
-    first: Vec<u32>,
-    binned: Vec<u32>,
     point: bool,
 }
 
-impl SphereGrid {
+impl Extents {
     fn new(scene: &Scene, sample: LightSample, casters: &[u32], receivers: &[u32]) -> Self {
         let n = scene.polygons.len();
         // Only casters and receivers are asked about.
@@ -359,14 +370,56 @@ impl SphereGrid {
         for &i in casters.iter().chain(receivers) {
             wanted[i as usize] = true;
         }
-        let (boxes, cones): (Vec<Boxes>, Vec<Cone>) = (0..n)
+        let (boxes, cones) = (0..n)
             .into_par_iter()
             .map(|i| if wanted[i] { extent(scene.verts(i), sample) } else { Extent::NONE })
             .map(|e| (e.boxes, e.cone))
             .unzip();
+        Extents { boxes, cones, point: matches!(sample, LightSample::Point(_)) }
+    }
+
+    /// Whether the extents of polygons `a` and `b` overlap: for a point light, their cones
+    /// (the angle between their axes is at most the sum of their half-angles: `acos(ac·bc)
+    /// <= ah + bh`, that is, the sum below π, where the cosine falls, `ac·bc >= cos(ah +
+    /// bh)`, with a hair of slack so that rounding can only keep a pair, never drop one);
+    /// for a directional light, their boxes.
+    fn overlap(&self, a: u32, b: u32) -> bool {
+        if self.point {
+            let (ac, bc) = (self.cones[a as usize], self.cones[b as usize]);
+            return ac.half + bc.half >= PI || ac.axis.dot(bc.axis) >= ac.cos * bc.cos - ac.sin * bc.sin - 1e-12;
+        }
+        let (Some(p), Some(q)) = (self.boxes[a as usize][0], self.boxes[b as usize][0]) else { return true };
+        p[0] <= q[2] && q[0] <= p[2] && p[1] <= q[3] && q[1] <= p[3]
+    }
+
+    /// The paper's prefilter for receiver `b`: every caster's extent compared with `b`'s,
+    /// the overlapping ones into `out`. Returns the pairs tested.
+    fn every_pair(&self, b: u32, casters: &[u32], out: &mut Vec<u32>) -> u64 {
+        out.clear();
+        out.extend(casters.iter().copied().filter(|&a| a != b && self.overlap(a, b)));
+        casters.iter().filter(|&&a| a != b).count() as u64
+    }
+}
+
+/// Step 2 found in a grid (ours): a grid over the extents' domain (polar angle × azimuth, or
+/// the plane's two axes) in which each caster is binned in every cell its extent touches,
+/// so that a receiver meets only the casters in its cells.
+struct SphereGrid {
+    extents: Extents,
+    domain: [f64; 4],
+    g: usize,
+    /// The casters binned in cell `k` (column-major, `c * g + r`) are
+    /// `binned[first[k]..first[k + 1]]`, in increasing order.
+    first: Vec<u32>,
+    binned: Vec<u32>,
+}
+
+impl SphereGrid {
+    fn new(extents: Extents, sample: LightSample, casters: &[u32]) -> Self {
         let domain = match sample {
             LightSample::Point(_) => [0.0, -PI, PI, PI],
-            LightSample::Directional(_) => boxes
+            LightSample::Directional(_) => extents
+                .boxes
                 .iter()
                 .flat_map(|b| b.iter().flatten())
                 .fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |d, b| {
@@ -374,15 +427,7 @@ impl SphereGrid {
                 }),
         };
         let g = ((casters.len() as f64).sqrt().ceil() as usize).clamp(4, 1024);
-        let mut grid = SphereGrid {
-            boxes,
-            cones,
-            domain,
-            g,
-            first: Vec::new(),
-            binned: Vec::new(),
-            point: matches!(sample, LightSample::Point(_)),
-        };
+        let mut grid = SphereGrid { extents, domain, g, first: Vec::new(), binned: Vec::new() };
         // Every (cell, caster) pair, found in parallel and in caster order, then counted
         // into the cells (a stable counting sort: each cell lists its casters in order).
         let binned: Vec<(u32, u32)> = casters
@@ -417,7 +462,7 @@ impl SphereGrid {
         let d = self.domain;
         let (lo, size) = (DVec2::new(d[0], d[1]), DVec2::new(d[2] - d[0], d[3] - d[1]).max(DVec2::splat(1e-300)));
         let g = self.g;
-        let boxes = self.boxes[i as usize].into_iter().flatten();
+        let boxes = self.extents.boxes[i as usize].into_iter().flatten();
         boxes.flat_map(move |b| grid_cells(lo, size, (g, g), (DVec2::new(b[0], b[1]), DVec2::new(b[2], b[3]))))
     }
 
@@ -427,22 +472,15 @@ impl SphereGrid {
     /// per polygon, that keeps each caster from being listed twice.
     fn candidates(&self, b: u32, stamp: &mut [u32], out: &mut Vec<u32>) {
         out.clear();
-        let bc = self.cones[b as usize];
         for (c, r) in self.cells_of(b) {
             for &a in self.cell(c, r) {
                 if stamp[a as usize] == b {
                     continue;
                 }
                 stamp[a as usize] = b;
-                // The cones overlap when the angle between their axes is at most the sum
-                // of their half-angles: `acos(ac·bc) <= ah + bh`, that is (the sum below π,
-                // where the cosine falls) `ac·bc >= cos(ah + bh)`, with a hair of slack so
-                // that rounding can only keep a pair, never drop one.
-                let overlap = !self.point || {
-                    let ac = self.cones[a as usize];
-                    ac.half + bc.half >= PI || ac.axis.dot(bc.axis) >= ac.cos * bc.cos - ac.sin * bc.sin - 1e-12
-                };
-                if overlap {
+                // Shared cells are a directional light's box test; a point light's cones
+                // are compared.
+                if !self.extents.point || self.extents.overlap(a, b) {
                     out.push(a);
                 }
             }
@@ -664,7 +702,8 @@ mod tests {
                 .unwrap();
             let n = scene.polygons.len();
             let casters: Vec<u32> = (0..n as u32).collect();
-            let grid = SphereGrid::new(&scene, LightSample::Point(light), &casters, &casters);
+            let sample = LightSample::Point(light);
+            let grid = SphereGrid::new(Extents::new(&scene, sample, &casters, &casters), sample, &casters);
             let mut stamp = vec![u32::MAX; n];
             let (mut found, mut kept) = (0, Vec::new());
             for b in 0..n as u32 {

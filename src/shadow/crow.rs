@@ -26,7 +26,7 @@
 //! volume never counts for its own face.
 
 use super::volumes::{Adjacency, Counting, ScreenVolumes};
-use super::{CountAdd, Decision, Detail, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
+use super::{Construction, CountAdd, Decision, Detail, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
 use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -51,11 +51,11 @@ impl<'a> Crow<'a> {
     pub fn new(ctx: &'a ShadowContext<'a>, options: VolumeOptions, counters: &mut Counters) -> Self {
         let counting = options.counting;
         let view = ctx.view;
-        let adjacency = Adjacency::kept(ctx.scene, options.silhouettes, &ctx.pools.stash);
+        let adjacency = Adjacency::kept(ctx.scene, options.construction != Construction::PerPolygon, &ctx.pools.stash);
         let samples = ctx
             .all_samples()
             .map(|(_, _, sample)| {
-                let volumes = ScreenVolumes::new(ctx, &adjacency, sample, counting, counters);
+                let volumes = ScreenVolumes::new(ctx, &adjacency, sample, options, counters);
                 let mut table = EdgeTable::new(view.height);
                 table.add_rings(&volumes.rings);
                 table.finish();

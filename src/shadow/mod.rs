@@ -36,12 +36,30 @@ use crate::stats::Counters;
 use crate::view::View;
 use crate::visibility::{FrameRuns, Run};
 
-/// Bouknight-Kelley's settings.
+/// Bouknight-Kelley's settings. [`BouknightKelleyOptions::PAPER`] is the paper's method as
+/// the "Árnyékolás" notes give it; every other switch turns on a step of ours
+/// (`docs/algorithms/bouknight-kelley.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct BouknightKelleyOptions {
-    /// Use the sphere prefilter (default true): pairs whose extents on a sphere around the
-    /// light do not overlap are dropped before any projection.
+    /// Use the sphere prefilter (default true; the paper's): pairs whose extents on a sphere
+    /// around the light do not overlap are dropped before any projection.
     pub prefilter: bool,
+    /// Find the prefilter's overlapping pairs in a grid over the sphere (default true; ours):
+    /// each receiver meets only the casters binned in its cells. `false` compares the
+    /// extents of every ordered pair, n(n−1) tests a light sample, as the paper does.
+    pub sphere_grid: bool,
+    /// Make only the polygons seen at some pixel receivers (default true; ours): the others
+    /// are never asked. `false` projects onto every polygon whose plane the light sample
+    /// lights on the eye's side, as the paper does before the scan.
+    pub seen_receivers: bool,
+    /// Drop, without projecting, the casters wholly behind the receiver as the light sees
+    /// it (default true; ours): their projection is empty. `false` projects them and finds
+    /// it empty, as the paper does.
+    pub drop_behind: bool,
+    /// Drop, without projecting, the casters wholly outside the wedge a triangle receiver
+    /// cuts from the light (default true; ours): their shadow falls beside the receiver.
+    /// `false` projects them, as the paper does.
+    pub wedge: bool,
     /// Drop, before the prefilter, the polygons of closed solids that face away from the
     /// light (default true; ours, not the paper's): on a closed mesh every shadow they cast
     /// is cast by the solid's polygons that face the light. `false` keeps the paper's
@@ -50,8 +68,26 @@ pub struct BouknightKelleyOptions {
 }
 
 impl BouknightKelleyOptions {
-    /// The paper's method with its prefilter, and the solid cull.
-    pub const DEFAULT: BouknightKelleyOptions = BouknightKelleyOptions { prefilter: true, solid_cull: true };
+    /// The paper's method with its prefilter, and every step of ours.
+    pub const DEFAULT: BouknightKelleyOptions = BouknightKelleyOptions {
+        prefilter: true,
+        sphere_grid: true,
+        seen_receivers: true,
+        drop_behind: true,
+        wedge: true,
+        solid_cull: true,
+    };
+
+    /// The paper's method as published: every ordered pair through the sphere prefilter,
+    /// every polygon the light faces a receiver, no step of ours.
+    pub const PAPER: BouknightKelleyOptions = BouknightKelleyOptions {
+        prefilter: true,
+        sphere_grid: false,
+        seen_receivers: false,
+        drop_behind: false,
+        wedge: false,
+        solid_cull: false,
+    };
 }
 
 impl Default for BouknightKelleyOptions {
@@ -85,13 +121,44 @@ pub struct AthertonWeilerGreenbergOptions {
     /// polygons turned to the light do not. `false` puts every polygon in the view, as the
     /// paper does.
     pub solid_cull: bool,
+    /// Cut each light view into regions of at most 128 casters and sort them apart (default
+    /// true; ours): what hides what inside a region depends only on what lies in it. `false`
+    /// sorts the whole view at once, as the paper does.
+    pub tiling: bool,
+    /// Map a polygon that lies wholly inside one face of the cube around a point light into
+    /// that face's view alone (default true; ours). `false` maps every polygon into all six
+    /// views, each clipping it to its own frustum.
+    pub face_binning: bool,
+    /// Find the pieces a front polygon may overlap in a grid over their boxes (default true;
+    /// ours). `false` hands the front polygon every piece still in the sort, as the paper's
+    /// clipper takes the whole list (a piece whose box misses the front polygon's is put
+    /// outside without clipping, the clipper's own first test).
+    pub sort_grid: bool,
 }
 
 impl AthertonWeilerGreenbergOptions {
-    /// The paper's two passes, with convex pieces split by edges, and backgrounds, lone
-    /// sheets and solids' polygons turned from the light left out of the sort.
-    pub const DEFAULT: AthertonWeilerGreenbergOptions =
-        AthertonWeilerGreenbergOptions { convex_split: true, backgrounds: true, lone_sheets: true, solid_cull: true };
+    /// The paper's two passes, and every step of ours.
+    pub const DEFAULT: AthertonWeilerGreenbergOptions = AthertonWeilerGreenbergOptions {
+        convex_split: true,
+        backgrounds: true,
+        lone_sheets: true,
+        solid_cull: true,
+        tiling: true,
+        face_binning: true,
+        sort_grid: true,
+    };
+
+    /// The paper as published: one area sort of each whole light view, every polygon in it,
+    /// Weiler and Atherton's clipper for every cut, no step of ours.
+    pub const PAPER: AthertonWeilerGreenbergOptions = AthertonWeilerGreenbergOptions {
+        convex_split: false,
+        backgrounds: false,
+        lone_sheets: false,
+        solid_cull: false,
+        tiling: false,
+        face_binning: false,
+        sort_grid: false,
+    };
 }
 
 impl Default for AthertonWeilerGreenbergOptions {
@@ -100,21 +167,66 @@ impl Default for AthertonWeilerGreenbergOptions {
     }
 }
 
+/// How the shadow volumes are built from the casting polygons.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[non_exhaustive]
+pub enum Construction {
+    /// Bergeron's 1986 general volumes: every casting polygon bounds a volume, and the sides
+    /// that neighbouring polygons share are merged, so that only silhouette and boundary
+    /// edges keep sides; closed solids' polygons turned away from the light are left out
+    /// (ours). Exact for any meshes and any light (the default).
+    #[default]
+    Merged,
+    /// Every casting polygon its own volume, nothing merged (to measure what merging saves).
+    PerPolygon,
+    /// Crow's 1977 construction, as published: one volume per object, its sides on the
+    /// object's contour edges (between a polygon turned to the light and one turned away),
+    /// its caps on the polygons turned to the light, and z-pass's count starting from the
+    /// number of volumes that hold the eye, one count for the whole image. Exact for closed,
+    /// outward-wound objects with the light outside them and no volume crossing the near
+    /// plane; wrong elsewhere, on purpose (`docs/algorithms/crow.md`).
+    Crow1977,
+}
+
+impl Construction {
+    /// The construction's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Construction::Merged => "merged",
+            Construction::PerPolygon => "per-polygon",
+            Construction::Crow1977 => "crow-1977",
+        }
+    }
+
+    /// Every construction.
+    pub const ALL: [Construction; 3] = [Construction::Merged, Construction::PerPolygon, Construction::Crow1977];
+}
+
+crate::error::named!(Construction, "volume construction");
+
 /// The settings of shadow volumes, counted per span (Crow) or per pixel (stencil).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct VolumeOptions {
     /// How the volumes are counted along the line of sight (default z-pass).
     pub counting: volumes::Counting,
-    /// Merge the sides that neighbouring polygons share, so that only silhouette and
-    /// boundary edges keep sides, and leave out the polygons of closed solids turned away
-    /// from the light (default true); `false` gives every polygon its own volume, to measure
-    /// the saving.
-    pub silhouettes: bool,
+    /// How the volumes are built (default: Bergeron's merged volumes).
+    pub construction: Construction,
+    /// Cut the volumes to where a count can reach (default true; ours): z-pass's sides to
+    /// the hull of the eye and the scene's bounds, and z-fail's volumes closed at a plane
+    /// beyond the scene. `false` extrudes every volume to infinity, as the papers do, and
+    /// z-fail's volumes are then clipped by the camera's far plane where the scene has one
+    /// (the failure Everitt and Kilgard's infinite far plane removes).
+    pub sight_cuts: bool,
 }
 
 impl VolumeOptions {
-    /// Z-pass with the eye's own count, on silhouette edges.
-    pub const DEFAULT: VolumeOptions = VolumeOptions { counting: volumes::Counting::ZPass, silhouettes: true };
+    /// Z-pass with the eye's own count, on merged volumes, cut to sight.
+    pub const DEFAULT: VolumeOptions =
+        VolumeOptions { counting: volumes::Counting::ZPass, construction: Construction::Merged, sight_cuts: true };
+
+    /// Crow's 1977 construction counted by z-pass, uncut: the paper as published.
+    pub const PAPER: VolumeOptions =
+        VolumeOptions { counting: volumes::Counting::ZPass, construction: Construction::Crow1977, sight_cuts: false };
 }
 
 impl Default for VolumeOptions {
@@ -426,13 +538,77 @@ impl ShadowMethod {
         }
     }
 
-    /// Whether the method gives the exact answer of `docs/scene-format.md` §3: every method
-    /// but the approximate ones, and shadow volumes counted by the naive z-pass.
+    /// The method as its paper publishes it, with none of our engineering (`--paper`):
+    /// Bouknight-Kelley, Atherton-Weiler-Greenberg and Crow's volumes (per span or in a
+    /// stencil) with every step of ours off ([`BouknightKelleyOptions::PAPER`] keeping the
+    /// prefilter's switch, [`AthertonWeilerGreenbergOptions::PAPER`], and Crow's 1977
+    /// construction uncut, keeping the count); every other method as it is (it has no steps
+    /// of ours to turn off, or is a reference).
+    ///
+    /// ```
+    /// use umbra::shadow::{BouknightKelleyOptions, ShadowMethod};
+    /// let bk: ShadowMethod = "bouknight-kelley".parse()?;
+    /// assert_eq!(bk.as_published(), ShadowMethod::BouknightKelley(BouknightKelleyOptions::PAPER));
+    /// assert!(bk.as_published().is_paper());
+    /// # Ok::<(), umbra::Error>(())
+    /// ```
+    pub fn as_published(&self) -> ShadowMethod {
+        match self {
+            ShadowMethod::BouknightKelley(o) => ShadowMethod::BouknightKelley(BouknightKelleyOptions {
+                prefilter: o.prefilter,
+                ..BouknightKelleyOptions::PAPER
+            }),
+            ShadowMethod::AthertonWeilerGreenberg(_) => {
+                ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions::PAPER)
+            }
+            ShadowMethod::Crow(v) => ShadowMethod::Crow(VolumeOptions { counting: v.counting, ..VolumeOptions::PAPER }),
+            ShadowMethod::StencilVolume(v) => {
+                ShadowMethod::StencilVolume(VolumeOptions { counting: v.counting, ..VolumeOptions::PAPER })
+            }
+            other => other.clone(),
+        }
+    }
+
+    /// Whether the method runs as its paper publishes it: [`ShadowMethod::as_published`]
+    /// leaves it unchanged and it has steps of ours to leave out (a paper path).
+    pub fn is_paper(&self) -> bool {
+        self.has_paper_path() && self.as_published() == *self
+    }
+
+    /// Whether the method has a paper path that differs from its engineered default.
+    pub fn has_paper_path(&self) -> bool {
+        matches!(
+            self,
+            ShadowMethod::BouknightKelley(_)
+                | ShadowMethod::AthertonWeilerGreenberg(_)
+                | ShadowMethod::Crow(_)
+                | ShadowMethod::StencilVolume(_)
+        )
+    }
+
+    /// The method's name in reports: its command-line name, with " (paper)" for a paper
+    /// path.
+    pub fn label(&self) -> String {
+        if self.is_paper() {
+            format!("{} (paper)", self.name())
+        } else {
+            self.name().to_string()
+        }
+    }
+
+    /// Whether the method gives the exact answer of `docs/scene-format.md` §3 on every
+    /// valid scene: every method but the approximate ones, shadow volumes counted by the
+    /// naive z-pass, Crow's 1977 construction (exact only where its preconditions hold) and
+    /// z-fail uncut (wrong where the camera's far plane cuts a volume).
     pub fn is_exact(&self) -> bool {
         match self {
             ShadowMethod::None | ShadowMethod::Williams(_) | ShadowMethod::Planar => false,
-            ShadowMethod::Crow(v) | ShadowMethod::StencilVolume(v) => v.counting != volumes::Counting::NaiveZPass,
-            _ => true,
+            ShadowMethod::Crow(v) | ShadowMethod::StencilVolume(v) => {
+                v.counting != volumes::Counting::NaiveZPass
+                    && v.construction != Construction::Crow1977
+                    && (v.sight_cuts || v.counting != volumes::Counting::ZFail)
+            }
+            ShadowMethod::RayCast | ShadowMethod::BouknightKelley(_) | ShadowMethod::AthertonWeilerGreenberg(_) => true,
         }
     }
 

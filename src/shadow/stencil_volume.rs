@@ -6,7 +6,7 @@
 //! shadow where its count is above zero.
 
 use super::volumes::{Adjacency, ScreenVolumes};
-use super::{Decision, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
+use super::{Construction, Decision, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
 use crate::scan::{for_each_span, EdgeTable};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -43,14 +43,14 @@ impl<'a> StencilVolume<'a> {
             }
         }
         let planes: Vec<Option<DepthPlane>> = scene.polygons.iter().map(|p| view.depth_plane(&p.plane)).collect();
-        let adjacency = Adjacency::kept(scene, options.silhouettes, &ctx.pools.stash);
+        let adjacency = Adjacency::kept(scene, options.construction != Construction::PerPolygon, &ctx.pools.stash);
         let counting = options.counting;
         let band = crate::scan::band_height(h);
         let mut writes = 0u64;
         let lit = ctx
             .all_samples()
             .map(|(_, _, sample)| {
-                let vols = ScreenVolumes::new(ctx, &adjacency, sample, counting, counters);
+                let vols = ScreenVolumes::new(ctx, &adjacency, sample, options, counters);
                 let mut stencil = ctx.pools.i32.filled(w * h as usize, 0);
                 let written: u64 = stencil
                     .par_chunks_mut(w * band as usize)

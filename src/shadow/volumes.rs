@@ -201,6 +201,144 @@ fn shadow_polygons(
     pieces
 }
 
+/// Crow's 1977 construction (the paper path, [`Construction::Crow1977`]) for one light
+/// sample, as published:
+///
+/// 1. The polygons *turned to the light*: those that cast shadows and have the light on
+///    their front side (the side their winding's normal points to).
+/// 2. Each object's *contour edges*, its outline as the light sees it: the edges between
+///    one of its polygons turned to the light and one turned away, and the edges of a
+///    polygon turned to the light that no other polygon of the object shares (an open
+///    mesh's boundary). Each gets a side, facing out of the volume of the polygons turned
+///    to the light. A polygon turned away from the light bounds no volume: on an open mesh
+///    (a single polygon seen from behind, a box without its bottom) its shadow is lost.
+/// 3. The caps: the polygons turned to the light are the volume's front (z-fail also closes
+///    it with their back caps at infinity).
+/// 4. Z-pass's starting count: the number of volumes that hold the eye, found as the
+///    polygons turned to the light that the segment from the eye to the light crosses (the
+///    sides lie in planes through the light, so the segment leaves a volume only through
+///    its front). One count for the whole image, entered as one polygon over the whole near
+///    plane.
+///
+/// The pieces of a non-planar face and self-crossing polygons keep their own volumes
+/// (section 2 of `docs/scene-format.md`; Crow's objects have no such polygons).
+fn crow_1977(
+    ctx: &ShadowContext,
+    adjacency: &Adjacency,
+    sample: LightSample,
+    counting: Counting,
+    camera: &Camera,
+) -> Vec<Piece> {
+    let (scene, b) = (ctx.scene, Builder::new(ctx, sample, counting, None));
+    // Step 1.
+    let facing: Vec<bool> = (0..scene.polygons.len())
+        .into_par_iter()
+        .map(|i| scene.casts_shadows(i) && sample.side_of(&scene.polygons[i].plane) > 0.0)
+        .collect();
+    let object = |s: &Sharing| scene.polygons[s.poly as usize].object;
+    // Step 2, edge by edge and object by object.
+    let mut pieces: Vec<Piece> = adjacency
+        .edges
+        .par_chunks(PIECE)
+        .map_init(Scratch::default, |scratch, edges| {
+            let mut piece = Piece::default();
+            for e in edges {
+                let sharing = &adjacency.sharing[e.first as usize..(e.first + e.count) as usize];
+                for (k, first) in sharing.iter().enumerate() {
+                    if sharing[..k].iter().any(|s| object(s) == object(first)) {
+                        continue; // this object's contour was decided already
+                    }
+                    let of_object = || sharing.iter().filter(|s| object(s) == object(first));
+                    let lit = || of_object().filter(|s| facing[s.poly as usize]);
+                    let (lit_count, all) = (lit().count(), of_object().count());
+                    // A contour edge: one turned to the light meets one turned away, or
+                    // an edge of one polygon turned to the light meets nothing.
+                    if lit_count == 0 || (lit_count == all && all > 1) {
+                        continue;
+                    }
+                    let w = b.net_weight(e.a, e.b, lit());
+                    piece.weights[usize::from(w.abs() != 1)] += u64::from(w != 0);
+                    piece.add(camera, scratch, b.side(e.a, e.b, w, None));
+                }
+            }
+            piece
+        })
+        .collect();
+    // Step 3.
+    let mut piece = Piece::default();
+    let (mut scratch, mut proj) = (Scratch::default(), Projector::default());
+    if counting == Counting::ZFail {
+        for &p in adjacency.merged.iter().filter(|&&p| facing[p as usize]) {
+            for cap in b.caps(&mut proj, scene.verts(p as usize), p as usize, None) {
+                piece.add(camera, &mut scratch, cap);
+            }
+        }
+    }
+    for apart in adjacency.apart.iter().filter(|apart| facing[apart.poly as usize]) {
+        let owner = Some(scene.polygons[apart.poly as usize].face);
+        let v = &apart.verts;
+        for k in 0..v.len() {
+            let (a, c) = (v[k], v[(k + 1) % v.len()]);
+            piece.add(camera, &mut scratch, b.side(a, c, b.net_weight_one(a, c, apart.poly as usize), owner));
+        }
+        if counting == Counting::ZFail {
+            for cap in b.caps(&mut proj, v, apart.poly as usize, owner) {
+                piece.add(camera, &mut scratch, cap);
+            }
+        }
+    }
+    // Step 4.
+    if counting == Counting::ZPass {
+        let eye = ctx.view.eye;
+        let merged = adjacency.merged.par_iter().filter(|&&p| facing[p as usize]);
+        let crossed = merged.filter(|&&p| crosses_to_light(scene.verts(p as usize), eye, sample)).count();
+        let apart =
+            adjacency.apart.iter().filter(|a| facing[a.poly as usize] && crosses_to_light(&a.verts, eye, sample));
+        let count = (crossed + apart.count()) as i32;
+        piece.eye_count = count;
+        if count != 0 {
+            let (plane, rect) = ctx.view.near_rectangle();
+            let over_the_image = ShadowPolygon {
+                verts: rect.iter().map(|&v| finite(v)).collect(),
+                plane: Some(plane),
+                sign: count,
+                part: Part::NearCap,
+                lies_on: None,
+                owner_face: None,
+            };
+            piece.add(camera, &mut scratch, Some(over_the_image));
+        }
+    }
+    pieces.push(piece);
+    pieces
+}
+
+/// Whether the segment from `eye` to the light sample (the ray toward a directional light)
+/// crosses polygon `verts` strictly inside, its ends off the polygon's plane.
+fn crosses_to_light(verts: &[DVec3], eye: DVec3, sample: LightSample) -> bool {
+    let plane = Plane::new(newell_normal(verts).normalize_or_zero(), verts[0]);
+    let de = plane.distance(eye);
+    let t = match sample {
+        LightSample::Point(s) => {
+            let ds = plane.distance(s);
+            if de * ds >= 0.0 {
+                return false;
+            }
+            (s - eye) * (de / (de - ds))
+        }
+        LightSample::Directional(d) => {
+            let along = -plane.n.dot(d);
+            if de == 0.0 || along == 0.0 || (de > 0.0) == (along > 0.0) {
+                return false;
+            }
+            -d * (-de / along)
+        }
+    };
+    let axis = dominant_axis(plane.n);
+    let ring: Vec<DVec2> = verts.iter().map(|&v| drop_axis(v, axis)).collect();
+    crate::geometry::inside_even_odd(&ring, drop_axis(eye + t, axis))
+}
+
 /// The shadow polygons one piece made, as they came out of the camera, with their tally.
 #[derive(Default)]
 struct Piece {
@@ -214,6 +352,8 @@ struct Piece {
     weights: [u64; 2],
     /// The sides wholly outside the sight hull.
     outside: u64,
+    /// Crow 1977's starting count: the volumes that hold the eye.
+    eye_count: i32,
 }
 
 impl Piece {
@@ -713,6 +853,11 @@ impl SightHull {
         SightHull { planes: vec![(far.plane.n, far.plane.d)] }
     }
 
+    /// The near side of the camera's far plane, at depth `far` along the view direction.
+    fn before_far(view: &crate::view::View, far: f64) -> Self {
+        SightHull { planes: vec![(-view.f, view.f.dot(view.eye) + far)] }
+    }
+
     /// Cuts `verts` (homogeneous) to the hull in place; `scratch` is scratch. Fewer than
     /// three vertices left means nothing of it is inside.
     pub(crate) fn clip(&self, verts: &mut Vec<DVec4>, scratch: &mut Vec<DVec4>) {
@@ -734,20 +879,22 @@ pub struct ScreenVolumes {
 }
 
 impl ScreenVolumes {
-    /// The shadow polygons of `sample` for `counting`, put through the camera: clipped to the
-    /// near plane in homogeneous coordinates (never to the far plane) and projected.
+    /// The shadow polygons of `sample` built and counted as `options` say, put through the
+    /// camera: clipped to the near plane in homogeneous coordinates and projected. With the
+    /// sight cuts (ours) they are never clipped to the camera's far plane; without them, as
+    /// a z-buffer renders them, they are.
     pub fn new(
         ctx: &ShadowContext,
         adjacency: &Adjacency,
         sample: LightSample,
-        counting: Counting,
+        options: super::VolumeOptions,
         counters: &mut Counters,
     ) -> Self {
-        let view = ctx.view;
+        let (view, counting) = (ctx.view, options.counting);
         // Z-pass counts between the eye and the visible point: its sides are cut to the hull
         // of the two. Z-fail, closed at a far plane, counts between the visible point and
         // that plane: its sides are cut there.
-        let bounds = ctx.scene.bounds();
+        let bounds = ctx.scene.bounds().filter(|_| options.sight_cuts);
         let (far, hull) = match counting {
             Counting::ZFail => {
                 let far = bounds.and_then(|b| FarPlane::new(b, view.eye, sample));
@@ -756,8 +903,16 @@ impl ScreenVolumes {
             }
             Counting::ZPass | Counting::NaiveZPass => (None, bounds.map(|b| SightHull::new(b, view.eye))),
         };
-        let camera = Camera { view, hull };
-        let pieces = shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), &camera);
+        let far_clip = if options.sight_cuts { None } else { view.far.map(|f| SightHull::before_far(view, f)) };
+        let camera = Camera { view, hull, far_clip };
+        let pieces = match options.construction {
+            super::Construction::Crow1977 => crow_1977(ctx, adjacency, sample, counting, &camera),
+            _ => shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), &camera),
+        };
+        let eye_count = pieces.iter().map(|p| p.eye_count).sum::<i32>();
+        if options.construction == super::Construction::Crow1977 && counting == Counting::ZPass {
+            counters.add("eye_count", eye_count.max(0) as u64);
+        }
         let sum = |of: &dyn Fn(&Piece) -> u64| pieces.iter().map(of).sum::<u64>();
         counters.add("merged_edges", adjacency.edges.len() as u64);
         counters.add("polygons_apart", adjacency.apart.len() as u64);
@@ -795,6 +950,9 @@ struct Camera<'v> {
     view: &'v crate::view::View,
     /// The hull that sides are cut to first (none: not cut).
     hull: Option<SightHull>,
+    /// The camera's far plane, which clips every shadow polygon but the near caps (the
+    /// paper path, without the sight cuts; none: no far plane, or the cuts are on).
+    far_clip: Option<SightHull>,
 }
 
 /// What became of one shadow polygon put through the camera.
@@ -822,18 +980,28 @@ impl Scratch {
     /// plane in homogeneous coordinates and projected.
     fn screen(&mut self, camera: &Camera, sp: &ShadowPolygon) -> Screened {
         let view = camera.view;
-        let verts = match &camera.hull {
-            Some(hull) if sp.part == Part::Side => {
+        let mut cut = false;
+        if let (Some(hull), Part::Side) = (&camera.hull, sp.part) {
+            self.cut.clear();
+            self.cut.extend_from_slice(&sp.verts);
+            hull.clip(&mut self.cut, &mut self.cut_scratch);
+            if self.cut.len() < 3 {
+                return Screened::OutOfSight;
+            }
+            cut = true;
+        }
+        if let Some(far) = camera.far_clip.as_ref().filter(|_| sp.part != Part::NearCap) {
+            if !cut {
                 self.cut.clear();
                 self.cut.extend_from_slice(&sp.verts);
-                hull.clip(&mut self.cut, &mut self.cut_scratch);
-                if self.cut.len() < 3 {
-                    return Screened::OutOfSight;
-                }
-                &self.cut
             }
-            _ => &sp.verts,
-        };
+            far.clip(&mut self.cut, &mut self.cut_scratch);
+            if self.cut.len() < 3 {
+                return Screened::Off;
+            }
+            cut = true;
+        }
+        let verts = if cut { &self.cut } else { &sp.verts };
         // A back cap lies on the plane at infinity: inverse depth 0, behind everything.
         let depth = match &sp.plane {
             Some(plane) => match view.depth_plane(plane) {

@@ -209,7 +209,7 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
                 let speedup_best = several.then(|| times_faster(first_min, m.frame.min_ms));
                 rows.push(BenchRow {
                     visibility: v.name().into(),
-                    shadows: s.name().into(),
+                    shadows: s.label(),
                     threads: pool.current_num_threads(),
                     runs: o.runs,
                     frame: m.frame,
@@ -335,13 +335,13 @@ pub fn table(rows: &[BenchRow]) -> String {
     phases.dedup();
     let cell = |s: &Spread| format!("{:.1} ({:.1}–{:.1})", s.median_ms, s.min_ms, s.max_ms);
     let ratio = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |x| format!("{x:.2}"));
-    let mut out = format!("{:<10} {:<26} {:>24}", "visibility", "shadows", "frame ms: median (min–max)");
+    let mut out = format!("{:<10} {:<34} {:>24}", "visibility", "shadows", "frame ms: median (min–max)");
     for p in &phases {
         out += &format!(" {:>22}", p);
     }
     out += &format!(" {:>9} {:>7} {:>8} {:>6} {:>6}\n", "peak MB", "threads", "speed-up", "best", "others");
     for r in rows {
-        out += &format!("{:<10} {:<26} {:>24}", r.visibility, r.shadows, cell(&r.frame));
+        out += &format!("{:<10} {:<34} {:>24}", r.visibility, r.shadows, cell(&r.frame));
         for p in &phases {
             out += &format!(" {:>22}", r.phases.get(*p).map_or_else(|| "-".to_string(), cell));
         }

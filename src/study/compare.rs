@@ -200,7 +200,7 @@ impl MethodResult {
     fn not_run(v: VisibilityMethod, s: &ShadowMethod, status: String) -> MethodResult {
         MethodResult {
             visibility: v.name().into(),
-            shadows: s.name().into(),
+            shadows: s.label(),
             status,
             exact: s.is_exact(),
             time: Spread { median_ms: 0.0, min_ms: 0.0, max_ms: 0.0 },
@@ -226,7 +226,7 @@ impl MethodResult {
         reference: &Frame,
         save: impl Fn(image::RgbImage, &str) -> Result<String>,
     ) -> Result<MethodResult> {
-        let id = format!("{v}-{s}");
+        let id = format!("{v}-{s}{}", if s.is_paper() { "-paper" } else { "" });
         let run = &m.last;
         let (interior, wrong, diff_img) = diff(reference, &run.frame);
         let counters = run
@@ -238,7 +238,7 @@ impl MethodResult {
             .collect();
         Ok(MethodResult {
             visibility: v.name().into(),
-            shadows: s.name().into(),
+            shadows: s.label(),
             status,
             exact: s.is_exact(),
             time: m.frame,

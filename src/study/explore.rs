@@ -97,13 +97,21 @@ struct Shown {
 pub struct Explorer {
     scene: Scene,
     name: String,
+    /// Whether the page starts with the paper paths (`--paper`).
+    paper: bool,
     shown: Mutex<VecDeque<Arc<Shown>>>,
 }
 
 impl Explorer {
     /// An explorer of `scene`, called `name` on the page.
     pub fn new(scene: Scene, name: impl Into<String>) -> Explorer {
-        Explorer { scene, name: name.into(), shown: Mutex::new(VecDeque::new()) }
+        Explorer { scene, name: name.into(), paper: false, shown: Mutex::new(VecDeque::new()) }
+    }
+
+    /// The same explorer, its page starting with the stages as their papers publish them
+    /// (`ShadowMethod::as_published`; the page's "as published" box).
+    pub fn with_paper(self, paper: bool) -> Explorer {
+        Explorer { paper, ..self }
     }
 
     /// Answers `GET url` (a path with an optional `?query`).
@@ -132,6 +140,8 @@ impl Explorer {
         let lights: Vec<Value> =
             self.scene.lights().iter().map(|l| json!({ "kind": kind_name(&l.kind), "at": at(&l.kind) })).collect();
         let stages: Vec<&str> = ShadowMethod::ALL.iter().map(|m| m.name()).collect();
+        let paper_stages: Vec<&str> =
+            ShadowMethod::ALL.iter().filter(|m| m.has_paper_path()).map(|m| m.name()).collect();
         json!({
             "name": self.name,
             "width": cam.width,
@@ -142,6 +152,8 @@ impl Explorer {
             "lights": lights,
             "stages": stages,
             "default_stage": ShadowMethod::DEFAULT.name(),
+            "paper_stages": paper_stages,
+            "paper": self.paper,
             "max_side": MAX_SIDE,
         })
     }
@@ -150,15 +162,26 @@ impl Explorer {
     fn request(&self, query: &str) -> Result<Request> {
         let cam = self.scene.camera();
         let mut r = Request { shadows: ShadowMethod::DEFAULT, width: cam.width, height: cam.height, light: None };
+        let mut paper = false;
         for (key, value) in pairs(query) {
             match key.as_str() {
                 "shadows" => r.shadows = value.parse()?,
+                "paper" => {
+                    paper = match value.as_str() {
+                        "1" | "true" => true,
+                        "0" | "false" => false,
+                        _ => return Err(Error::InvalidOption(format!("paper '{value}' is not 1 or 0"))),
+                    }
+                }
                 "width" => r.width = side("width", &value)?,
                 "height" => r.height = side("height", &value)?,
                 "light" => r.light = Some(point(&value)?),
                 "line" | "index" => {}
                 _ => return Err(Error::InvalidOption(format!("unknown parameter '{key}'"))),
             }
+        }
+        if paper {
+            r.shadows = r.shadows.as_published();
         }
         Ok(r)
     }
@@ -273,7 +296,7 @@ fn summary(scene: &Scene, r: &Request, got: &Rendered, reference: &Rendered, out
     let outlines: Vec<Vec<[f64; 2]>> =
         outlines.iter().take(MAX_OUTLINES).map(|ring| ring.iter().map(|p| p.to_array()).collect()).collect();
     json!({
-        "shadows": r.shadows.name(),
+        "shadows": r.shadows.label(),
         "exact": r.shadows.is_exact(),
         "width": r.width,
         "height": r.height,

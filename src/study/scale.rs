@@ -159,7 +159,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
             points.push(Point {
                 value,
                 visibility: v.name().into(),
-                shadows: s.name().into(),
+                shadows: s.label(),
                 polygons: scene.polygons.len(),
                 time: m.frame,
                 counter,
@@ -377,7 +377,7 @@ impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
         for (i, (v, s)) in self.o.methods.iter().enumerate() {
             let colour = Palette99::pick(i).to_rgba();
             let mine: Vec<&Point> =
-                positive.iter().copied().filter(|p| p.visibility == v.name() && p.shadows == s.name()).collect();
+                positive.iter().copied().filter(|p| p.visibility == v.name() && p.shadows == s.label()).collect();
             let series: Vec<(f64, f64)> = mine.iter().map(|p| (x(p), (self.y)(p))).collect();
             chart.draw_series(LineSeries::new(series.clone(), colour.stroke_width(2))).err_text()?;
             chart.draw_series(series.into_iter().map(|p| Circle::new(p, 3, colour.filled()))).err_text()?;

@@ -133,7 +133,7 @@ pub fn trace_lines(
             walker.start_line(line);
             let active = aet.advance_to(line).iter().map(|c| (c.x, screen[c.tag as usize].poly)).collect();
             let decisions = decide(ctx, walker.as_mut(), line, &runs);
-            let shadows = shadows.name().into();
+            let shadows = shadows.label();
             emit(LineTrace { line, shadows, entering, leaving, active, spans, runs, decisions })?;
         }
         Ok(())

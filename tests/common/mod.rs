@@ -52,28 +52,26 @@ pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
     use umbra::shadow::Counting;
     use umbra::shadow::{AthertonWeilerGreenbergOptions, BouknightKelleyOptions, VolumeOptions};
     let volumes = |counting| VolumeOptions { counting, ..VolumeOptions::default() };
+    let uncut = |counting| VolumeOptions { counting, sight_cuts: false, ..VolumeOptions::default() };
     vec![
         ("bouknight-kelley".into(), ShadowMethod::BouknightKelley(BouknightKelleyOptions::default())),
         (
             "bouknight-kelley --no-prefilter".into(),
-            ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false, solid_cull: true }),
+            ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false, ..Default::default() }),
         ),
         (
             "bouknight-kelley --no-solid-cull".into(),
-            ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: true, solid_cull: false }),
+            ShadowMethod::BouknightKelley(BouknightKelleyOptions { solid_cull: false, ..Default::default() }),
         ),
+        ("bouknight-kelley --paper".into(), ShadowMethod::BouknightKelley(BouknightKelleyOptions::PAPER)),
         ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg(Default::default())),
         (
-            "atherton-weiler-greenberg --no-convex-split --no-backgrounds --no-lone-sheets --no-solid-cull".into(),
-            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions {
-                convex_split: false,
-                backgrounds: false,
-                lone_sheets: false,
-                solid_cull: false,
-            }),
+            "atherton-weiler-greenberg --paper".into(),
+            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions::PAPER),
         ),
         ("crow zpass".into(), ShadowMethod::Crow(volumes(Counting::ZPass))),
         ("crow zfail".into(), ShadowMethod::Crow(volumes(Counting::ZFail))),
+        ("crow zpass --no-sight-cuts".into(), ShadowMethod::Crow(uncut(Counting::ZPass))),
         ("stencil-volume zpass".into(), ShadowMethod::StencilVolume(volumes(Counting::ZPass))),
         ("stencil-volume zfail".into(), ShadowMethod::StencilVolume(volumes(Counting::ZFail))),
     ]

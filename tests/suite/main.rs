@@ -11,6 +11,7 @@ mod cli;
 mod explore;
 mod fuzz;
 mod loading;
+mod paper;
 mod reflection;
 mod shading;
 mod shadows;

@@ -38,7 +38,7 @@ const INTRO = {
 };
 
 const state = {
-  scene: null, stage: "", width: 0, height: 0, light: null,
+  scene: null, stage: "", paper: false, width: 0, height: 0, light: null,
   line: 0, x: null, frame: null, trace: null, playing: null, token: 0, scale: 1,
 };
 const staticLines = {};
@@ -48,6 +48,7 @@ const staticLines = {};
 function params(extra) {
   const p = new URLSearchParams({ shadows: state.stage, width: state.width, height: state.height });
   if (state.light) p.set("light", state.light.map((v) => v.toFixed(4)).join(","));
+  if (state.paper && state.scene.paper_stages.includes(state.stage)) p.set("paper", "1");
   for (const [k, v] of Object.entries(extra || {})) p.set(k, v);
   return p.toString();
 }
@@ -374,9 +375,9 @@ function hasDetail(d) {
 
 function drawStage(t) {
   const panel = $("stage-panel");
-  panel.dataset.stage = t.shadows;
+  panel.dataset.stage = state.stage;
   $("stage-title").textContent = `Shadow stage: ${t.shadows}`;
-  $("stage-intro").textContent = INTRO[t.shadows] || "";
+  $("stage-intro").textContent = INTRO[state.stage] || "";
   const d = pickedDecision(t);
   $("stage-map-box").hidden = true;
   const c = $("stage-canvas");
@@ -555,7 +556,13 @@ function setUpControls() {
   for (const s of stages) stage.appendChild(cell("option", s, { value: s }));
   state.stage = stages.includes(sc.default_stage) ? sc.default_stage : stages[0];
   stage.value = state.stage;
-  stage.onchange = () => { state.stage = stage.value; loadFrame(); };
+  // The paper path: live only, for the stages that have one.
+  const paper = $("paper");
+  const paperFits = () => { paper.disabled = !sc.paper_stages.includes(state.stage); };
+  state.paper = paper.checked = !STATIC && sc.paper;
+  paperFits();
+  paper.onchange = () => { state.paper = paper.checked; loadFrame(); };
+  stage.onchange = () => { state.stage = stage.value; paperFits(); loadFrame(); };
 
   const size = $("size");
   const aspect = sc.height / sc.width;
