@@ -349,6 +349,15 @@ struct RenderArgs {
     /// the "Special Effect" notes' method 2), reflect the eye (eye, method 1), or render mirrors plainly (off).
     #[arg(long, default_value = "scene", value_parser = parse::<ReflectionMethod>)]
     reflection: ReflectionMethod,
+    /// Shastry's soft edges on any shadow stage (crow: the article's soft edges on shadow
+    /// volumes): each light sample's lit fractions in a screen buffer, blurred by the
+    /// article's 15-tap Gaussian or by a 16-tap Poisson disk.
+    #[arg(long, value_name = "BLUR", value_parser = parse::<umbra::shadow::Blur>)]
+    soft_edges: Option<umbra::shadow::Blur>,
+    /// With --soft-edges: the blur's taps this many pixels apart (the article's 1; wider
+    /// spacing, wider blur), from 0.25 to 64.
+    #[arg(long, default_value_t = 1.0, requires = "soft_edges")]
+    tap_spacing: f64,
 }
 
 #[derive(clap::Args)]
@@ -673,6 +682,7 @@ fn render_command(a: RenderArgs) -> umbra::Result<()> {
         reflection: a.reflection,
         outlines: a.debug.is_some(),
         back_face_cull: !a.no_back_face_cull,
+        soft_edges: a.soft_edges.map(|blur| umbra::shadow::SoftEdges { blur, spacing: a.tap_spacing }),
     };
     let bar = Arc::new(TerminalBar::new("{msg:40} {bar:30} {pos}/{len} lines {elapsed}"));
     let shown = bar.clone();

@@ -40,6 +40,10 @@ pub struct RenderOptions {
     /// On by default; the images are the same either way, up to which of two polygons meeting
     /// at a silhouette edge is seen exactly on it.
     pub back_face_cull: bool,
+    /// Shastry's soft edges on the shadow stage's answers (`None`, the default: as the stage
+    /// gives them): each light sample's lit fractions blurred in a screen buffer
+    /// ([`crate::shadow::SoftEdges`]; `docs/algorithms/williams.md`).
+    pub soft_edges: Option<crate::shadow::SoftEdges>,
 }
 
 impl Default for RenderOptions {
@@ -51,6 +55,7 @@ impl Default for RenderOptions {
             pixel_counters: false,
             reflection: crate::reflection::ReflectionMethod::default(),
             back_face_cull: true,
+            soft_edges: None,
         }
     }
 }
@@ -276,12 +281,15 @@ fn frame_pass(
     stats.time_ms.insert("visibility", ms(t.elapsed()));
 
     let t = Instant::now();
-    bar.phase(format!("shadow preparation ({})", opts.shadows.name()));
+    bar.phase(format!("shadow preparation ({})", opts.shadows.label()));
     let ctx = ShadowContext::new(scene, &view, &runs, opts.outlines)
         .with_pools(pools)
         .with_awg_database(kept.awg_database.clone());
     stats.light_samples = ctx.samples.iter().map(Vec::len).sum();
-    let shadows = opts.shadows.prepare(&ctx, &mut stats.shadow_counters)?;
+    let mut shadows = opts.shadows.prepare(&ctx, &mut stats.shadow_counters)?;
+    if let Some(soft) = opts.soft_edges {
+        shadows = Box::new(soft_edged(&ctx, shadows.as_ref(), soft)?);
+    }
     stats.time_ms.insert("shadow_prepare", ms(t.elapsed()));
 
     let t = Instant::now();
@@ -453,6 +461,55 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
     walker.finish(&mut shadow);
     shadow.add("self_shadowed_runs", self_shadowed);
     (shadow, walking, shading)
+}
+
+/// Shastry's soft edges on `stage`: its answers walked into a screen buffer per light
+/// sample (step 1 of [`crate::shadow::soft_edges`]), in parallel bands, then blurred.
+fn soft_edged(
+    ctx: &ShadowContext,
+    stage: &dyn crate::shadow::ShadowStage,
+    soft: crate::shadow::SoftEdges,
+) -> Result<crate::shadow::soft_edges::SoftEdged> {
+    soft.check()?;
+    let (w, h) = (ctx.view.width as usize, ctx.view.height);
+    let samples: usize = ctx.samples.iter().map(Vec::len).sum();
+    // The terms and their blurred copies, and one pass's scratch.
+    let bytes = crate::budget::mul(crate::budget::mul(samples as u64 + 1, w as u64 * h as u64), 8);
+    crate::budget::check(format_args!("soft edges: {samples} screen buffer(s) of {w}x{h}"), bytes)?;
+    let band = crate::scan::band_height(h);
+    let bands: Vec<Vec<f32>> = (0..h.div_ceil(band))
+        .into_par_iter()
+        .map(|b| {
+            let (y0, y1) = (b * band, ((b + 1) * band).min(h));
+            let mut walker = stage.walker();
+            let mut lit = vec![0.0f32; samples * w];
+            // Sample-major rows of this band: `out[k][(y - y0) * w + x]`, 1 where nothing is seen.
+            let mut out = vec![1.0f32; samples * (y1 - y0) as usize * w];
+            let per_sample = (y1 - y0) as usize * w;
+            for y in y0..y1 {
+                walker.start_line(y);
+                let runs = &ctx.runs.lines[y as usize];
+                walk_line(ctx, walker.as_mut(), y, runs, &mut lit, |_, _, _, _, _, _| {});
+                for run in runs {
+                    for k in 0..samples {
+                        let (a, b) = (run.x0 as usize, run.x1 as usize);
+                        let at = k * per_sample + (y - y0) as usize * w;
+                        out[at + a..at + b].copy_from_slice(&lit[k * w + a..k * w + b]);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    let mut terms = vec![Vec::with_capacity(w * h as usize); samples];
+    for (b, out) in bands.iter().enumerate() {
+        let rows = (((b as u32 + 1) * band).min(h) - b as u32 * band) as usize;
+        for (k, term) in terms.iter_mut().enumerate() {
+            term.extend_from_slice(&out[k * rows * w..(k + 1) * rows * w]);
+        }
+    }
+    let first = (0..ctx.samples.len()).map(|l| ctx.sample_index(l, 0)).collect();
+    Ok(crate::shadow::soft_edges::SoftEdged::new(terms, w, h as usize, first, soft))
 }
 
 /// Background pixels: no polygon, no light.

@@ -878,47 +878,8 @@ impl<'a> Williams<'a> {
                 self.lookup_run(light, s, y as u32, run, &mut batch, &mut row[run.x0 as usize..run.x1 as usize]);
             }
         });
-        let taps = seed_gaussian_taps();
-        let horizontal = blur(&term, w, h, &taps, true);
-        blur(&horizontal, w, h, &taps, false).into_iter().map(|v| v.clamp(0.0, 1.0)).collect()
+        super::soft_edges::SoftEdges::default().blurred(&term, w, h)
     }
-}
-
-/// One pass of a separable blur over a `w×h` buffer, along rows or columns, with clamped
-/// addressing at the borders (as a texture sampler clamps).
-fn blur(src: &[f32], w: usize, h: usize, taps: &[(i64, f32)], along_rows: bool) -> Vec<f32> {
-    let mut out = vec![0.0f32; w * h];
-    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, o) in row.iter_mut().enumerate() {
-            *o = taps
-                .iter()
-                .map(|&(off, wt)| {
-                    let (sx, sy) = if along_rows {
-                        ((x as i64 + off).clamp(0, w as i64 - 1) as usize, y)
-                    } else {
-                        (x, (y as i64 + off).clamp(0, h as i64 - 1) as usize)
-                    };
-                    src[sy * w + sx] * wt
-                })
-                .sum();
-        }
-    });
-    out
-}
-
-/// Shastry's 15 taps (offset in pixels, weight): the centre weighted `G(0, ρ = 2)`, then for
-/// i = 1, 3, …, 13 the offsets `+i` and `−i` weighted `2 G(i, 3)` and `2 G(i + 1, 3)`, with
-/// `G(x, ρ) = exp(−x²/2ρ²)/√(2πρ²)`. Reproduced as published: the taps skip even offsets,
-/// the two sides are weighted unequally, and the weights sum to about 1.07 (the blurred term
-/// is clamped to [0, 1], as the article's 8-bit render target does).
-pub(crate) fn seed_gaussian_taps() -> Vec<(i64, f32)> {
-    let g = |x: f64, rho: f64| (-(x * x) / (2.0 * rho * rho)).exp() / (2.0 * std::f64::consts::PI * rho * rho).sqrt();
-    let mut taps = vec![(0i64, g(0.0, 2.0) as f32)];
-    for i in (1..15).step_by(2) {
-        taps.push((i, (2.0 * g(i as f64, 3.0)) as f32));
-        taps.push((-i, (2.0 * g(i as f64 + 1.0, 3.0)) as f32));
-    }
-    taps
 }
 
 impl ShadowStage for Williams<'_> {
@@ -1005,7 +966,7 @@ mod tests {
 
     #[test]
     fn seed_gaussian_weights() {
-        let taps = seed_gaussian_taps();
+        let taps = crate::shadow::soft_edges::gaussian_taps();
         assert_eq!(taps.len(), 15);
         let offsets: Vec<i64> = taps.iter().map(|t| t.0).collect();
         assert_eq!(offsets, vec![0, 1, -1, 3, -3, 5, -5, 7, -7, 9, -9, 11, -11, 13, -13]);

@@ -262,3 +262,30 @@ fn stochastic_percentage_closer_filter() {
     let (interior, wrong, _) = umbra::study::compare::diff(&want, &one);
     assert!(wrong * 50 < interior, "{wrong} of {interior} interior pixels wrong");
 }
+
+/// Shastry's soft edges run on any stage: on Crow's exact volumes they soften the shadow
+/// edges (values strictly between 0 and 1 appear, all within [0, 1]); and Williams'
+/// `soft-edge` filter is the same thing as its PCF term with the soft edges applied.
+#[test]
+fn soft_edges_soften_any_stage_and_equal_williams_soft_edge_filter() {
+    use umbra::shadow::{Blur, SoftEdges};
+    let scene = load_scaled(&"scenes/cornell.toml".into(), 160);
+    let render = |shadows, soft_edges| {
+        let opts = umbra::RenderOptions { shadows, soft_edges, ..Default::default() };
+        umbra::render(&scene, &opts).unwrap().frame
+    };
+    let crow: ShadowMethod = "crow".parse().unwrap();
+    let exact = render(crow.clone(), None);
+    for blur in [Blur::Gaussian, Blur::Poisson] {
+        let soft = render(crow.clone(), Some(SoftEdges { blur, spacing: 1.0 }));
+        let l = &soft.light[0];
+        assert!(l.iter().all(|v| (0.0..=1.0).contains(v)), "{blur:?}");
+        let between = l.iter().filter(|&&v| v > 0.0 && v < 1.0).count();
+        let sharp = exact.light[0].iter().filter(|&&v| v > 0.0 && v < 1.0).count();
+        assert!(between > 500 && sharp == 0, "{blur:?}: {between} soft pixels, {sharp} in the exact frame");
+    }
+    let williams = |filter| ShadowMethod::Williams(WilliamsOptions { filter, ..Default::default() });
+    let filtered = render(williams(ShadowFilter::SoftEdge(3)), None);
+    let applied = render(williams(ShadowFilter::Pcf(3)), Some(SoftEdges::default()));
+    assert_eq!(filtered.light, applied.light);
+}
