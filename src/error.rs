@@ -66,10 +66,18 @@ pub enum Error {
         /// What is wrong, one line.
         message: String,
     },
-    /// A file could not be read or written.
+    /// A file could not be read.
     #[error("{}: {source}", path.display())]
     Io {
         /// The file.
+        path: PathBuf,
+        /// The system's reason.
+        source: std::io::Error,
+    },
+    /// A file or folder could not be written.
+    #[error("{}: could not write it: {source}", path.display())]
+    Write {
+        /// The file or folder.
         path: PathBuf,
         /// The system's reason.
         source: std::io::Error,

@@ -191,9 +191,13 @@ pub fn geodesic_sphere(centre: DVec3, r: f64, levels: u32) -> Mesh {
     Mesh::from_polygons(&polygons)
 }
 
-/// A UV sphere of radius `r` at `c` with about `triangles` triangles (at least 2 stacks).
+/// A UV sphere of radius `r` at `c` with as near `triangles` triangles as a UV sphere has:
+/// `s` stacks and `2s` slices make `4s² − 4s` triangles, and `s` (at least 2) is the one
+/// that comes nearest.
 pub fn sphere_mesh(c: DVec3, r: f64, triangles: u32) -> Mesh {
-    let stacks = ((triangles as f64 / 4.0).sqrt().round() as u32).max(2);
+    let made = |s: u32| 4 * s as i64 * s as i64 - 4 * s as i64;
+    let guess = ((1.0 + (1.0 + triangles as f64).sqrt()) / 2.0).floor().max(2.0) as u32;
+    let stacks = [guess, guess + 1].into_iter().min_by_key(|&s| (made(s) - triangles as i64).abs()).unwrap_or(2);
     let slices = 2 * stacks;
     let mut m = Mesh::default();
     let pos = |i: u32, j: u32| {

@@ -595,7 +595,8 @@ struct GenerateArgs {
     /// Depth complexity (quads).
     #[arg(long, default_value_t = 16)]
     depth: u32,
-    /// Triangles in all (spheres).
+    /// Triangles in all (spheres): each sphere is the UV sphere nearest `triangles / count`
+    /// (4s² − 4s triangles for s stacks); the count written is printed.
     #[arg(long, default_value_t = 10_000)]
     triangles: u32,
     /// Number of spheres (spheres).
@@ -748,19 +749,18 @@ fn compare_command(a: CompareArgs) -> umbra::Result<()> {
     let report = compare(&scene, &scene_name(&a.scene), &opts, |p| bar.report(p));
     bar.finish();
     let report = report?;
-    let mut table = String::new();
+    let mut table = format!(
+        "{:>9}   {:<34} {:>26}  {:>17}  {}\n",
+        "visibility", "shadows", "frame ms: median (min–max)", "wrong / interior", "status"
+    );
     for r in &report.results {
-        table += &format!(
-            "{:>9} + {:<34} {:>9.1} ms ({:.1}–{:.1})  {:>8} / {:<8} wrong  {}\n",
-            r.visibility,
-            r.shadows,
-            r.time.median_ms,
-            r.time.min_ms,
-            r.time.max_ms,
-            r.wrong_pixels,
-            r.interior_pixels,
-            r.status
-        );
+        if r.status != "ok" {
+            table += &format!("{:>9} + {:<34} {:>26}  {:>17}  {}\n", r.visibility, r.shadows, "—", "—", r.status);
+            continue;
+        }
+        let time = format!("{:.1} ({:.1}–{:.1})", r.time.median_ms, r.time.min_ms, r.time.max_ms);
+        let wrong = format!("{} / {}", r.wrong_pixels, r.interior_pixels);
+        table += &format!("{:>9} + {:<34} {:>26}  {:>17}  {}\n", r.visibility, r.shadows, time, wrong, r.status);
         if let Some(c) = r.map_errors {
             table += &format!(
                 "{:>46} acne {}, detached {}, aliasing {}, resolution {}\n",
@@ -827,12 +827,17 @@ fn scale_command(a: ScaleArgs) -> umbra::Result<()> {
         counter: a.counter,
         out: a.out.clone(),
     };
-    let mut table = String::new();
+    let mut table = format!(
+        "{:>10} {:>9}   {:<34} {:>26}  {}\n",
+        opts.sweep.name(),
+        "visibility",
+        "shadows",
+        "frame ms: median (min–max)",
+        opts.counter
+    );
     for p in scale(&opts)? {
-        table += &format!(
-            "{:>10} {:>9} + {:<34} {:>9.1} ms ({:.1}–{:.1})  {}\n",
-            p.value, p.visibility, p.shadows, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
-        );
+        let time = format!("{:.1} ({:.1}–{:.1})", p.time.median_ms, p.time.min_ms, p.time.max_ms);
+        table += &format!("{:>10} {:>9} + {:<34} {:>26}  {}\n", p.value, p.visibility, p.shadows, time, p.counter);
     }
     stdout(&table)?;
     say(&format!("wrote {}", a.out.display()))
@@ -884,8 +889,14 @@ fn generate_command(g: GenerateArgs) -> umbra::Result<()> {
     let meshes: Vec<PathBuf> = (0..scene.objects().len()).map(|i| dir.join(format!("{stem}_{i}.obj"))).collect();
     refuse_overwrite(&[&[g.output.clone()][..], &meshes].concat(), g.force)?;
     scene.write(&g.output)?;
+    let asked = match g.family {
+        Family::Spheres if scene.polygons().len() != g.triangles as usize + 1 => {
+            format!(", the nearest UV spheres to {} triangles and the floor", g.triangles)
+        }
+        _ => String::new(),
+    };
     say(&format!(
-        "wrote {} ({} polygons) and {} mesh(es) in {}",
+        "wrote {} ({} polygons{asked}) and {} mesh(es) in {}",
         g.output.display(),
         scene.polygons().len(),
         meshes.len(),
@@ -933,7 +944,7 @@ fn stdout(text: &str) -> umbra::Result<()> {
     let mut out = std::io::stdout().lock();
     out.write_all(text.as_bytes())
         .and_then(|()| out.flush())
-        .map_err(|e| Error::Io { path: "standard output".into(), source: e })
+        .map_err(|e| Error::Write { path: "standard output".into(), source: e })
 }
 
 /// Refuses an output name with an extension other than `.png` (only PNG is encoded; a name
@@ -946,13 +957,17 @@ fn check_png_name(path: &std::path::Path) -> umbra::Result<()> {
     Err(Error::InvalidOption(format!("{}: umbra writes PNG only; name the output file *.png", path.display())))
 }
 
-/// Writes the image as PNG, in one write so that a failed write is an error.
+/// Writes the image as PNG, in one write so that a failed write is an error; missing
+/// folders on the way are made first, as `--aov` and `generate` make theirs.
 fn write_png(img: image::RgbImage, path: &std::path::Path) -> umbra::Result<()> {
     check_png_name(path)?;
     let mut bytes = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
         .map_err(|e| Error::Image { path: path.to_owned(), source: e.into() })?;
-    std::fs::write(path, bytes).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| Error::Write { path: dir.to_owned(), source: e })?;
+    }
+    std::fs::write(path, bytes).map_err(|e| Error::Write { path: path.to_owned(), source: e })
 }
 
 fn parse_gamma(s: &str) -> Result<f32, String> {

@@ -192,7 +192,7 @@ impl Frame {
     /// frame has per-pixel counters, `depth_complexity.png`, `span_splits.png` and
     /// `shadow_tests.png` in false colour with a legend.
     pub fn save_aovs(&self, dir: &Path) -> Result<()> {
-        std::fs::create_dir_all(dir).map_err(|e| Error::Io { path: dir.to_owned(), source: e })?;
+        std::fs::create_dir_all(dir).map_err(|e| Error::Write { path: dir.to_owned(), source: e })?;
         self.save(self.id_image().into(), &dir.join("id.png"))?;
         self.save(self.id_view_image().into(), &dir.join("id_view.png"))?;
         for k in 0..self.light.len() {
@@ -261,9 +261,13 @@ pub fn check_gamma(gamma: f32) -> Result<()> {
 
 /// Encodes `img` as PNG in memory, then writes the file in one call, so that a failed write
 /// (a full disk, `/dev/full`) is an error and never a silently truncated file.
+/// Missing folders on the way are made first, as `--aov` and `generate` make theirs.
 pub(crate) fn write_png(img: image::DynamicImage, path: &Path) -> Result<()> {
     let bytes = png_bytes(&img, path)?;
-    std::fs::write(path, bytes).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| Error::Write { path: dir.to_owned(), source: e })?;
+    }
+    std::fs::write(path, bytes).map_err(|e| Error::Write { path: path.to_owned(), source: e })
 }
 
 /// The image encoded as PNG, in memory.

@@ -153,8 +153,8 @@ struct RawCamera {
     target: V3,
     up: Option<Spanned<V3>>,
     fov_y: Option<Spanned<Num>>,
-    width: Option<Spanned<u32>>,
-    height: Option<Spanned<u32>>,
+    width: Option<Spanned<i64>>,
+    height: Option<Spanned<i64>>,
     near: Option<Spanned<Num>>,
     far: Option<Spanned<Num>>,
 }
@@ -297,13 +297,20 @@ fn camera(cx: &Ctx, raw: Spanned<RawCamera>) -> Result<Camera> {
     let cam_span = raw.span();
     let c = raw.into_inner();
     let num = |x: &Option<Spanned<Num>>| x.as_ref().map(|x| x.get_ref().0);
+    // A side outside u32 (a negative width) is named with the range, as any other size is.
+    let side = |x: &Option<Spanned<i64>>, name: &str, default: u32| match x {
+        None => Ok(default),
+        Some(v) => u32::try_from(*v.get_ref())
+            .map_err(|_| cx.err(v.span(), format!("camera {name} {} must be 1..=32768 (pixels)", v.get_ref()))),
+    };
+    let (width, height) = (side(&c.width, "width", 640)?, side(&c.height, "height", 480)?);
     let camera = Camera {
         eye: v3(*c.eye.get_ref()),
         target: v3(c.target),
         up: c.up.as_ref().map_or(DVec3::Y, |u| v3(*u.get_ref())),
         fov_y: num(&c.fov_y).unwrap_or(45.0),
-        width: c.width.as_ref().map_or(640, |w| *w.get_ref()),
-        height: c.height.as_ref().map_or(480, |h| *h.get_ref()),
+        width,
+        height,
         near: num(&c.near).unwrap_or(0.01),
         far: num(&c.far),
     };

@@ -153,7 +153,7 @@ impl ObjText {
 
     /// Writes the text to `path` in one call.
     pub(crate) fn save(self, path: &Path) -> Result<()> {
-        std::fs::write(path, self.text).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+        std::fs::write(path, self.text).map_err(|e| Error::Write { path: path.to_owned(), source: e })
     }
 }
 

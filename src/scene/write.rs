@@ -21,7 +21,7 @@ impl Scene {
         let dir = path.parent().unwrap_or(Path::new(""));
         let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
         let meshes = dir.join("meshes");
-        std::fs::create_dir_all(&meshes).map_err(|e| Error::Io { path: meshes.clone(), source: e })?;
+        std::fs::create_dir_all(&meshes).map_err(|e| Error::Write { path: meshes.clone(), source: e })?;
         let mut t = String::new();
         self.write_camera(&mut t);
         for m in &self.materials {
@@ -35,7 +35,7 @@ impl Scene {
             mesh_obj(&o.mesh).save(&dir.join(&mesh_name))?;
             self.write_object(&mut t, o, &mesh_name);
         }
-        std::fs::write(path, t).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+        std::fs::write(path, t).map_err(|e| Error::Write { path: path.to_owned(), source: e })
     }
 
     /// The `[camera]` and `[render]` tables. (Writing into a String cannot fail.)

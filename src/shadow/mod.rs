@@ -571,6 +571,55 @@ impl ShadowMethod {
         }
     }
 
+    /// The method as written on the command line: its name, then the flags that set its
+    /// options apart from the defaults (`crow --crow-count zfail`, `williams --shadow-filter
+    /// pcf --pcf-size 5`; a paper path: `bouknight-kelley --paper`). For reports.
+    ///
+    /// ```
+    /// use umbra::shadow::{Counting, ShadowMethod, VolumeOptions};
+    /// let z_fail = ShadowMethod::Crow(VolumeOptions { counting: Counting::ZFail, ..Default::default() });
+    /// assert_eq!(z_fail.command_line(), "crow --crow-count zfail");
+    /// assert_eq!(z_fail.as_published().command_line(), "crow --paper --crow-count zfail");
+    /// ```
+    pub fn command_line(&self) -> String {
+        let paper = self.is_paper();
+        let mut on: Vec<(bool, String)> = vec![(paper, "--paper".into())];
+        match self {
+            ShadowMethod::BouknightKelley(o) => {
+                on.push((!o.prefilter, "--no-prefilter".into()));
+                if !paper {
+                    on.push((!o.sphere_grid, "--no-sphere-grid".into()));
+                    on.push((!o.seen_receivers, "--all-receivers".into()));
+                    on.push((!o.drop_behind, "--no-drop-behind".into()));
+                    on.push((!o.wedge, "--no-wedge".into()));
+                    on.push((!o.solid_cull, "--no-solid-cull".into()));
+                }
+            }
+            ShadowMethod::AthertonWeilerGreenberg(o) if !paper => {
+                on.push((!o.convex_split, "--no-convex-split".into()));
+                on.push((!o.backgrounds, "--no-backgrounds".into()));
+                on.push((!o.lone_sheets, "--no-lone-sheets".into()));
+                on.push((!o.solid_cull, "--no-solid-cull".into()));
+                on.push((!o.tiling, "--no-tiling".into()));
+                on.push((!o.face_binning, "--no-face-binning".into()));
+                on.push((!o.sort_grid, "--no-sort-grid".into()));
+            }
+            ShadowMethod::Crow(v) | ShadowMethod::StencilVolume(v) => {
+                on.push((v.counting != volumes::Counting::ZPass, format!("--crow-count {}", v.counting.name())));
+                if !paper {
+                    let construction = v.construction != Construction::Merged;
+                    on.push((construction, format!("--volumes {}", v.construction.name())));
+                    on.push((!v.sight_cuts, "--no-sight-cuts".into()));
+                }
+            }
+            ShadowMethod::Williams(o) => on.extend(o.flags().into_iter().map(|f| (true, f))),
+            _ => {}
+        }
+        let mut flags = vec![self.name().to_string()];
+        flags.extend(on.into_iter().filter(|(set, _)| *set).map(|(_, f)| f));
+        flags.join(" ")
+    }
+
     /// Whether the method runs as its paper publishes it: [`ShadowMethod::as_published`]
     /// leaves it unchanged and it has steps of ours to leave out (a paper path).
     pub fn is_paper(&self) -> bool {

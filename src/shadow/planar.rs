@@ -77,7 +77,9 @@ impl<'a> Planar<'a> {
             (0..scene.polygons.len()).filter(|&i| scene.objects[scene.polygons[i].object as usize].receiver).collect();
         if receivers.is_empty() {
             return Err(Error::NotApplicable(
-                "planar shadows need a receiver: mark the ground's object with receiver = true".into(),
+                "planar shadows need a receiver: mark the ground's object with receiver = true, or name it \
+                 on the command line (--receiver NAME, or --receiver auto for every large flat object)"
+                    .into(),
             ));
         }
         counters.add("receivers", receivers.len() as u64);

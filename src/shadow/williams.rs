@@ -106,6 +106,40 @@ impl WilliamsOptions {
 }
 
 impl WilliamsOptions {
+    /// The command-line flags that set these options apart from the defaults.
+    pub(crate) fn flags(&self) -> Vec<String> {
+        let d = WilliamsOptions::DEFAULT;
+        let mut f = Vec::new();
+        if self.map_size != d.map_size {
+            f.push(format!("--map-size {}", self.map_size));
+        }
+        if let Some(b) = self.bias {
+            f.push(format!("--bias {b}"));
+        }
+        if self.slope_bias != d.slope_bias {
+            f.push(format!("--slope-bias {}", self.slope_bias));
+        }
+        if self.normal_offset != d.normal_offset {
+            f.push(format!("--normal-offset {}", self.normal_offset));
+        }
+        if self.receiver_plane {
+            f.push("--receiver-plane".into());
+        }
+        match self.filter {
+            ShadowFilter::Nearest => {}
+            ShadowFilter::Pcf(n) => f.push(format!("--shadow-filter pcf --pcf-size {n}")),
+            ShadowFilter::Stochastic(n) => f.push(format!("--shadow-filter stochastic --pcf-size {n}")),
+            ShadowFilter::SoftEdge(n) => f.push(format!("--shadow-filter soft-edge --pcf-size {n}")),
+        }
+        if self.cull_front {
+            f.push("--cull-front".into());
+        }
+        if !self.fit_to_view {
+            f.push("--no-fit".into());
+        }
+        f
+    }
+
     /// The largest map side accepted (a 16,384² map takes a gigabyte).
     pub const MAX_MAP_SIZE: u32 = 16_384;
 

@@ -142,7 +142,7 @@ pub fn compare(
     progress: impl Fn(crate::Progress<'_>) + Send + Sync,
 ) -> Result<Report> {
     let img_dir = opts.out.join("img");
-    std::fs::create_dir_all(&img_dir).map_err(|e| Error::Io { path: img_dir.clone(), source: e })?;
+    std::fs::create_dir_all(&img_dir).map_err(|e| Error::Write { path: img_dir.clone(), source: e })?;
     let save = |img: image::RgbImage, file: &str| -> Result<String> {
         let path = img_dir.join(file);
         crate::frame::write_png(img.into(), &path)?;
@@ -181,8 +181,10 @@ pub fn compare(
     }
     let report = Report {
         about: super::About::now(format!(
-            "warmup {}, runs {}, shadow stages {:?}",
-            opts.warmup, opts.runs, opts.shadows
+            "warmup {}, runs {}, shadow stages: {}",
+            opts.warmup,
+            opts.runs,
+            opts.shadows.iter().map(ShadowMethod::command_line).collect::<Vec<_>>().join("; ")
         )),
         scene: name.into(),
         width: scene.camera.width,
@@ -256,7 +258,7 @@ impl MethodResult {
 }
 
 fn write(path: &Path, text: &str) -> Result<()> {
-    std::fs::write(path, text).map_err(|e| Error::Io { path: path.to_owned(), source: e })
+    std::fs::write(path, text).map_err(|e| Error::Write { path: path.to_owned(), source: e })
 }
 
 fn write_files(report: &Report, out: &Path) -> Result<()> {
@@ -495,6 +497,19 @@ fn results_table(report: &Report, out: &Path, h: &mut String) {
         } else {
             ""
         };
+        if r.status != "ok" {
+            // Not run: no time, no error, said so.
+            let _ = writeln!(
+                h,
+                "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td>{}</tr>",
+                super::method_link(&r.visibility, out),
+                super::method_link(&r.shadows, out),
+                escape(&r.status),
+                if r.exact { "yes" } else { "no" },
+                "<td>—</td>".repeat(9)
+            );
+            continue;
+        }
         let _ = writeln!(
             h,
             "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td{noisy}>{:.1} ({:.1}–{:.1})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td><td>{}</td></tr>",

@@ -412,7 +412,7 @@ pub fn serve(explorer: Explorer, port: u16, ready: impl FnOnce(&str)) -> Result<
 /// Writes the page with every line of every applicable stage precomputed into `dir`, at
 /// `width` x `height`, for reading from disk or any static web host.
 pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: &[ShadowMethod]) -> Result<()> {
-    let io = |path: &Path, e: std::io::Error| Error::Io { path: path.to_owned(), source: e };
+    let io = |path: &Path, e: std::io::Error| Error::Write { path: path.to_owned(), source: e };
     let write = |name: &str, bytes: &[u8]| {
         let path = dir.join(name);
         if let Some(parent) = path.parent() {

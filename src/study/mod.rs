@@ -77,7 +77,9 @@ impl About {
 /// checkout this program was built from) by a path relative to the report in `dir`; the
 /// bare name where that page is not on this machine, or the method has none.
 pub(crate) fn method_link(name: &str, dir: &std::path::Path) -> String {
-    let page = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/algorithms").join(format!("{name}.md"));
+    // A paper path's label links its stage's page.
+    let stage = name.strip_suffix(" (paper)").unwrap_or(name);
+    let page = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/algorithms").join(format!("{stage}.md"));
     let href = page.canonicalize().ok().zip(dir.canonicalize().ok()).map(|(page, dir)| relative(&page, &dir));
     match href {
         Some(href) => format!("<a href=\"{}\">{}</a>", escape(&href), escape(name)),
@@ -134,6 +136,7 @@ mod tests {
         let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/compare");
         assert_eq!(method_link("crow", &here), "<a href=\"../algorithms/crow.md\">crow</a>");
         assert_eq!(method_link("none", &here), "none");
+        assert_eq!(method_link("crow (paper)", &here), "<a href=\"../algorithms/crow.md\">crow (paper)</a>");
     }
 
     #[test]

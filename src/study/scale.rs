@@ -140,7 +140,7 @@ pub struct Point {
 /// measured with) and `index.html` (a page of both), and with the `plots` feature (on by default)
 /// `time.svg` and `counter.svg`, into `out`.
 pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
-    std::fs::create_dir_all(&o.out).map_err(|e| Error::Io { path: o.out.clone(), source: e })?;
+    std::fs::create_dir_all(&o.out).map_err(|e| Error::Write { path: o.out.clone(), source: e })?;
     let (kind, name) = o.counter.split_once('.').unwrap_or(("visibility", &o.counter));
     if kind != "visibility" && kind != "shadow" {
         return Err(Error::InvalidOption(format!("counter '{}' is not visibility.NAME or shadow.NAME", o.counter)));
@@ -185,19 +185,19 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         );
     }
     let about = super::About::now(format!(
-        "sweep {} over {:?}, {} timed run(s) after one warm-up, {}x{}, methods {:?}",
+        "sweep {} over {}, {} timed run(s) after one warm-up, {}x{}, methods: {}",
         o.sweep.name(),
-        o.values,
+        o.values.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(", "),
         o.runs.max(1),
         o.width,
         o.height,
-        o.methods
+        o.methods.iter().map(|(v, s)| format!("{} + {}", v.name(), s.command_line())).collect::<Vec<_>>().join("; ")
     ));
     let json = serde_json::json!({ "about": about, "counter": o.counter, "points": points });
     let path = o.out.join("scale.json");
-    std::fs::write(&path, json.to_string()).map_err(|e| Error::Io { path, source: e })?;
+    std::fs::write(&path, json.to_string()).map_err(|e| Error::Write { path, source: e })?;
     let path = o.out.join("scale.csv");
-    std::fs::write(&path, csv).map_err(|e| Error::Io { path, source: e })?;
+    std::fs::write(&path, csv).map_err(|e| Error::Write { path, source: e })?;
     #[cfg(feature = "plots")]
     {
         let spread: Bounds = |p| (p.time.min_ms, p.time.max_ms);
@@ -213,7 +213,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         super::plot::save(&counter, &o.out.join("counter"))?;
     }
     let path = o.out.join("index.html");
-    std::fs::write(&path, page(o, &points, &about)).map_err(|e| Error::Io { path, source: e })?;
+    std::fs::write(&path, page(o, &points, &about)).map_err(|e| Error::Write { path, source: e })?;
     Ok(points)
 }
 

@@ -355,3 +355,93 @@ fn receiver_makes_planar_shadows_usable_on_any_scene() {
     refused(&["render", cornell, "--shadows", "planar", "--receiver", "9", "-o", out], "no object 9");
     refused(&["scale", "--sweep", "cubes", "--values", "1", "--receiver", "auto"], "cannot be used here");
 }
+
+/// Reports a reader takes in without the source: every printed table of `compare` and
+/// `scale` starts with a header line, and a stage that does not apply reads as such, with
+/// the fix, in place of zero times and errors.
+#[test]
+fn printed_tables_have_headers_and_say_not_applicable() {
+    let d = tmp("tables");
+    let out = umbra()
+        .args([
+            "compare",
+            SMALL,
+            "--shadows",
+            "crow,planar",
+            "--visibility",
+            "scanline",
+            "--runs",
+            "1",
+            "--warmup",
+            "0",
+        ])
+        .arg("--out")
+        .arg(d.join("cmp"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or_default();
+    assert!(header.contains("visibility") && header.contains("wrong / interior"), "{text}");
+    let planar = lines.find(|l| l.contains("planar")).unwrap_or_default();
+    assert!(planar.contains("not applicable") && planar.contains("--receiver auto"), "{planar}");
+    assert!(!planar.contains("0.0"), "a row that did not run shows no time: {planar}");
+    // The HTML report says the same, and names the options as the command line does.
+    let html = std::fs::read_to_string(d.join("cmp/report.html")).unwrap();
+    assert!(!html.contains("Options {") && html.contains("shadow stages: crow; planar"), "options as Rust text");
+    let row = html.lines().find(|l| l.contains("<tr") && l.contains("not applicable")).unwrap_or_default();
+    assert!(row.contains("—") && !row.contains("0.0000%"), "{row}");
+    let out = umbra()
+        .args(["scale", "--sweep", "cubes", "--values", "1,2", "--runs", "1", "--width", "32", "--height", "24"])
+        .arg("--out")
+        .arg(d.join("scale"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let header = text.lines().next().unwrap_or_default();
+    assert!(header.contains("cubes") && header.contains("visibility.depth_tests"), "{text}");
+}
+
+/// `-o` into a folder that does not exist makes it, as `--aov` and `generate` do; where it
+/// cannot be made the message says the write failed.
+#[test]
+fn output_folders_are_made_and_failed_writes_say_so() {
+    let d = tmp("folders");
+    let png = d.join("new/deeper/o.png");
+    let out = umbra().args(["render", SMALL, "-o"]).arg(&png).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(png.exists());
+    refused(&["render", SMALL, "-o", "/proc/no-such-folder/o.png"], "could not write");
+}
+
+/// A negative image size is named with the range, like any other bad size, not as a type.
+#[test]
+fn a_negative_size_is_named_with_its_range() {
+    let d = tmp("negative");
+    let bad = d.join("neg.toml");
+    std::fs::write(&bad, "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nwidth = -5\n").unwrap();
+    let out = umbra().arg("render").arg(&bad).arg("-o").arg(d.join("o.png")).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("neg.toml:4:") && err.contains("width -5 must be 1..=32768"), "{err}");
+}
+
+/// Generated spheres come as near the triangles asked for as UV spheres can, and the
+/// message says how many were written.
+#[test]
+fn generated_spheres_come_near_the_triangles_asked_for() {
+    let d = tmp("spheres");
+    let out = umbra()
+        .args(["generate", "spheres", "--triangles", "5000", "--count", "3", "-o"])
+        .arg(d.join("s.toml"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let s = umbra::Scene::load(d.join("s.toml")).unwrap();
+    let spheres = s.polygons().len() as i64 - 1;
+    assert!((spheres - 5000).abs() <= 5000 / 50, "{spheres} triangles for 5,000 asked");
+    assert!(String::from_utf8_lossy(&out.stderr).contains(&format!("{} polygons", spheres + 1)));
+}
