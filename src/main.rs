@@ -6,8 +6,10 @@ mod cli {
 
 use clap::{Parser, Subcommand, ValueEnum};
 use cli::progress::TerminalBar;
+use std::alloc::{GlobalAlloc, Layout};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use std::sync::Arc;
 use umbra::shadow::Counting;
 use umbra::shadow::{
@@ -22,7 +24,67 @@ use umbra::{generate, Error, RenderOptions, Renderer, Scene, ShadowMethod, Visib
 /// to the system each time and the next frame faults their pages in again (about a fifth of
 /// an s3 frame). mimalloc keeps them, once told not to purge them ([`keep_freed_memory`]).
 #[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+static ALLOCATOR: Counted = Counted(mimalloc::MiMalloc);
+
+/// mimalloc, with the bytes in use and their peak counted, so that `bench` can give each
+/// row its own peak memory ([`umbra::study::bench::HeapProbe`]): the resident high-water
+/// mark only rises, and mimalloc keeps what it frees ([`keep_freed_memory`]).
+struct Counted(mimalloc::MiMalloc);
+
+/// Bytes allocated and not yet freed.
+static IN_USE: AtomicUsize = AtomicUsize::new(0);
+/// The most bytes in use since the last [`reset_peak`].
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+fn grew(bytes: usize) {
+    let now = IN_USE.fetch_add(bytes, Relaxed) + bytes;
+    PEAK.fetch_max(now, Relaxed);
+}
+
+fn reset_peak() {
+    PEAK.store(IN_USE.load(Relaxed), Relaxed);
+}
+
+fn peak_bytes() -> u64 {
+    PEAK.load(Relaxed) as u64
+}
+
+// SAFETY: every call is passed on to mimalloc unchanged; only counters are updated beside.
+unsafe impl GlobalAlloc for Counted {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: as the caller promised for `layout`.
+        let p = unsafe { self.0.alloc(layout) };
+        if !p.is_null() {
+            grew(layout.size());
+        }
+        p
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: as the caller promised for `layout`.
+        let p = unsafe { self.0.alloc_zeroed(layout) };
+        if !p.is_null() {
+            grew(layout.size());
+        }
+        p
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: `ptr` came from this allocator with `layout`, as the caller promised.
+        unsafe { self.0.dealloc(ptr, layout) };
+        IN_USE.fetch_sub(layout.size(), Relaxed);
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        // SAFETY: as the caller promised for `ptr`, `layout` and `new_size`.
+        let p = unsafe { self.0.realloc(ptr, layout, new_size) };
+        if !p.is_null() {
+            IN_USE.fetch_sub(layout.size(), Relaxed);
+            grew(new_size);
+        }
+        p
+    }
+}
 
 /// Tells mimalloc never to give freed memory back to the system. By default it does so 10 ms
 /// after a free, and a shadow stage that builds many short-lived lists (Bouknight-Kelley's
@@ -783,6 +845,7 @@ fn bench_command(a: BenchArgs) -> umbra::Result<()> {
         back_face_cull: !a.no_back_face_cull,
         undisturbed: a.undisturbed,
         threads: a.threads,
+        heap: Some(umbra::study::bench::HeapProbe { reset: reset_peak, peak_bytes }),
     };
     let rows = umbra::study::bench::bench(&scene, &opts, |what| {
         use std::io::Write;

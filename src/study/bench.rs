@@ -2,8 +2,8 @@
 //! be. The scene is loaded once; each method renders `warmup` frames that are not timed (page
 //! faults, caches, the shadow maps' storage), then `runs` timed frames in the same process.
 //! Each row gives the median, least and greatest time of the whole frame and of every phase
-//! the pipeline reports, the process's peak resident memory so far, and how many cores other
-//! processes used meanwhile. Asked to (`undisturbed`), it waits for the other processes to leave
+//! the pipeline reports, the row's own peak memory (where the program counts its heap,
+//! [`HeapProbe`]), and how many cores other processes used meanwhile. Asked to (`undisturbed`), it waits for the other processes to leave
 //! the machine quiet before each row and times a row again when they did not, as the peers'
 //! harness in the benchmark suite does.
 
@@ -41,6 +41,21 @@ pub struct BenchOptions {
     /// core alone; time a row again, up to three tries in all, when others used a quarter of
     /// a core or more while it ran, or the cores ran 15% slower together right after it.
     pub undisturbed: bool,
+    /// How the program counts its heap, for each row's own peak memory (none: only the
+    /// process's resident high-water mark is known, which after a large row stays high for
+    /// every row after it).
+    pub heap: Option<HeapProbe>,
+}
+
+/// A program's count of its heap (a counting global allocator): `reset` makes the peak the
+/// bytes in use now, `peak_bytes` reads the most in use since. The `umbra` binary counts
+/// its allocator's bytes this way.
+#[derive(Debug, Clone, Copy)]
+pub struct HeapProbe {
+    /// Makes the peak the bytes in use now.
+    pub reset: fn(),
+    /// The most bytes in use since the last reset.
+    pub peak_bytes: fn() -> u64,
 }
 
 /// Foreign cores under which the machine counts as quiet, over [`QUIET_WINDOW`].
@@ -109,8 +124,11 @@ pub struct BenchRow {
     /// Each phase the pipeline reports (`view`, `visibility`, `shadow_prepare`, `shading`,
     /// `reflections` where mirrors are seen).
     pub phases: BTreeMap<String, Spread>,
+    /// The row's own peak: the most heap in use while it ran, the scene's included, in MB
+    /// (`None` without a [`HeapProbe`]).
+    pub peak_mb: Option<f64>,
     /// The process's peak resident memory after the row, in MB (0 where the system does
-    /// not say).
+    /// not say): a high-water mark, so a row after a larger one shows the larger one's.
     pub peak_rss_mb: f64,
     /// What else the machine did while the row ran.
     #[serde(flatten)]
@@ -195,6 +213,9 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
     for &v in &o.visibility {
         for s in &o.shadows {
             progress(&format!("{v} + {s}"));
+            if let Some(h) = o.heap {
+                (h.reset)();
+            }
             let opts = RenderOptions {
                 visibility: v,
                 shadows: s.clone(),
@@ -202,6 +223,7 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
                 ..RenderOptions::default()
             };
             let (each, disturbance) = measure_undisturbed(scene, &opts, o, &pools, &mut progress)?;
+            let peak_mb = o.heap.map(|h| (h.peak_bytes)() as f64 / (1024.0 * 1024.0));
             let (first, first_min) = (each[0].times_ms.clone(), each[0].frame.min_ms);
             for (m, pool) in each.into_iter().zip(&pools) {
                 let several = pools.len() > 1;
@@ -216,6 +238,7 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
                     speedup,
                     speedup_best,
                     phases: m.phases,
+                    peak_mb,
                     peak_rss_mb: peak_rss_mb(),
                     disturbance,
                 });
@@ -324,30 +347,73 @@ fn peak_rss_mb() -> f64 {
         .map_or(0.0, |kb| kb / 1024.0)
 }
 
-/// The rows as a readable table: one line per method, the frame and each phase as
-/// `median (min–max)`, then the peak memory, the threads, the speed-up over the first thread
-/// count (median of pairs, then fastest against fastest) and the cores others used.
+/// The rows as a readable table, at most 120 columns for the usual labels: one line per
+/// method, the frame as `median (min–max)` and each phase's median in ms, the row's own peak
+/// memory, and where they say something: the threads with the speed-up over the first count
+/// (median of pairs, then fastest against fastest), and the cores others used. Every
+/// phase's spread and the resident high-water mark are in `--json`.
 pub fn table(rows: &[BenchRow]) -> String {
     // The phases in the pipeline's order, then any others by name.
     const ORDER: [&str; 6] = ["view", "visibility", "shadow_prepare", "shadow_walk", "shading", "reflections"];
     let mut phases: Vec<&str> = rows.iter().flat_map(|r| r.phases.keys().map(String::as_str)).collect();
     phases.sort_by_key(|p| (ORDER.iter().position(|o| o == p).unwrap_or(ORDER.len()), *p));
     phases.dedup();
-    let cell = |s: &Spread| format!("{:.1} ({:.1}–{:.1})", s.median_ms, s.min_ms, s.max_ms);
-    let ratio = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |x| format!("{x:.2}"));
-    let mut out = format!("{:<10} {:<34} {:>24}", "visibility", "shadows", "frame ms: median (min–max)");
-    for p in &phases {
-        out += &format!(" {:>22}", p);
+    let short = |p: &str| match p {
+        "shadow_prepare" => "prepare".to_string(),
+        "shadow_walk" => "walk".to_string(),
+        other => other.to_string(),
+    };
+    let several = rows.iter().any(|r| r.speedup.is_some());
+    // One visibility stage for every row: named once above the table, not on every row.
+    let one_visibility = rows.first().map(|r| &r.visibility).filter(|v| rows.iter().all(|r| &r.visibility == *v));
+    let others = rows.iter().any(|r| r.disturbance.foreign_cores.is_some());
+    let method = if one_visibility.is_some() { "shadows" } else { "visibility + shadows" };
+    let mut header: Vec<String> = vec![method.into(), "frame (min–max)".into()];
+    header.extend(phases.iter().map(|p| short(p)));
+    header.push("peak MB".into());
+    if several {
+        header.extend(["threads", "speed-up", "best"].map(String::from));
     }
-    out += &format!(" {:>9} {:>7} {:>8} {:>6} {:>6}\n", "peak MB", "threads", "speed-up", "best", "others");
-    for r in rows {
-        out += &format!("{:<10} {:<34} {:>24}", r.visibility, r.shadows, cell(&r.frame));
-        for p in &phases {
-            out += &format!(" {:>22}", r.phases.get(*p).map_or_else(|| "-".to_string(), cell));
+    if others {
+        header.push("others".into());
+    }
+    let ratio = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |x| format!("{x:.2}"));
+    let lines: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            let f = &r.frame;
+            let name =
+                if one_visibility.is_some() { r.shadows.clone() } else { format!("{} + {}", r.visibility, r.shadows) };
+            let mut cells = vec![name, format!("{:.1} ({:.1}–{:.1})", f.median_ms, f.min_ms, f.max_ms)];
+            cells.extend(phases.iter().map(|p| r.phases.get(*p).map_or("-".into(), |s| format!("{:.1}", s.median_ms))));
+            cells.push(r.peak_mb.map_or_else(|| format!("{:.0}*", r.peak_rss_mb), |m| format!("{m:.0}")));
+            if several {
+                cells.extend([r.threads.to_string(), ratio(r.speedup), ratio(r.speedup_best)]);
+            }
+            if others {
+                cells.push(r.disturbance.foreign_cores.map_or("-".into(), |c| format!("{c:.2}")));
+            }
+            cells
+        })
+        .collect();
+    let widths: Vec<usize> = (0..header.len())
+        .map(|c| std::iter::once(&header).chain(&lines).map(|l| l[c].chars().count()).max().unwrap_or(0))
+        .collect();
+    let line = |cells: &[String]| {
+        let mut out = format!("{:<w$}", cells[0], w = widths[0]);
+        for (c, w) in cells.iter().zip(&widths).skip(1) {
+            out += &format!(" {c:>w$}", w = *w);
         }
-        let others = r.disturbance.foreign_cores.map_or_else(|| "-".to_string(), |f| format!("{f:.2}"));
-        let (speedup, best) = (ratio(r.speedup), ratio(r.speedup_best));
-        out += &format!(" {:>9.0} {:>7} {:>8} {:>6} {:>6}\n", r.peak_rss_mb, r.threads, speedup, best, others);
+        out + "\n"
+    };
+    let mut out = one_visibility.map_or_else(String::new, |v| format!("visibility: {v}\n"));
+    out += &line(&header);
+    for l in &lines {
+        out += &line(l);
+    }
+    out += "times in ms: the frame's median (least–greatest), each phase's median; --json has every spread\n";
+    if rows.iter().any(|r| r.peak_mb.is_none()) {
+        out += "* the process's resident high-water mark: no heap count for this row\n";
     }
     out
 }

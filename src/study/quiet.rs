@@ -17,6 +17,9 @@ use std::time::{Duration, Instant};
 /// runs umbra on).
 const TICKS_PER_S: f64 = 100.0;
 
+/// The shortest stretch whose foreign cores are reported: 100 ticks.
+pub(crate) const MIN_STRETCH: Duration = Duration::from_secs(1);
+
 /// Foreign cores measured from a point in time on.
 pub(crate) struct Monitor {
     start: Instant,
@@ -30,8 +33,12 @@ impl Monitor {
     }
 
     /// The cores other processes used on average since [`Monitor::start`], never below 0;
-    /// `None` where the system does not say.
+    /// `None` where the system does not say, or the stretch is under [`MIN_STRETCH`] (too
+    /// few ticks: a short row read 0 to 3 cores on a 2-core machine for the same command).
     pub(crate) fn foreign(&self) -> Option<f64> {
+        if self.start.elapsed() < MIN_STRETCH {
+            return None;
+        }
         let ((busy0, own0), (busy1, own1)) = (self.ticks?, ticks()?);
         Some(foreign_cores(busy1.saturating_sub(busy0), own1.saturating_sub(own0), self.start.elapsed()))
     }
