@@ -306,7 +306,7 @@ fn measure_undisturbed(
                 pool.install(|| timing.frame(scene, opts, timed))?;
             }
         }
-        let foreign = monitor.foreign();
+        let foreign = monitor.foreign_if_long();
         let contention = o.undisturbed.then(|| quiet::core_contention(cores));
         let each = timings.into_iter().map(Timing::finish).collect::<Result<Vec<_>>>()?;
         let disturbed = foreign.is_some_and(|f| f >= DISTURBED) || contention.is_some_and(|c| c >= CONTENDED);

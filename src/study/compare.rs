@@ -295,7 +295,7 @@ fn write_files(report: &Report, out: &Path) -> Result<()> {
 mod charts {
     use super::{MethodResult, Report};
     use crate::error::Result;
-    use crate::study::plot::{log_ticks, save, Chart, ErrText};
+    use crate::study::plot::{colour, log_ticks, place_labels, save, Chart, ErrText};
     use plotters::coord::combinators::BindKeyPoints;
     use plotters::coord::Shift;
     use plotters::prelude::*;
@@ -347,23 +347,44 @@ mod charts {
                 .y_desc("interior pixels wrong, %")
                 .draw()
                 .err_text()?;
-            // Each point numbered, the numbers alternating above and below so that neighbours
-            // on the zero line stay legible, and the key beside the plot.
+            // Each point numbered, and the key beside the plot. The numbers are placed in
+            // pixels so that none overlaps another or covers a point; one moved away from its
+            // point is joined to it by a thin leader line.
             let mut by_time = ok.to_vec();
             by_time.sort_by(|a, b| a.time.median_ms.total_cmp(&b.time.median_ms));
+            let (exact, approximate) = (colour(0), colour(1));
+            let at: Vec<(f64, f64)> = by_time.iter().map(|r| (r.time.median_ms, 100.0 * r.error_share)).collect();
+            let pixels: Vec<(i32, i32)> = at.iter().map(|&p| chart.backend_coord(&p)).collect();
+            let font = ("sans-serif", 12).into_font();
+            let sizes: Vec<(i32, i32)> = (1..=at.len())
+                .map(|i| {
+                    root.estimate_text_size(&i.to_string(), &font.clone().into_text_style(root))
+                        .map_or((14, 12), |(w, h)| (w as i32, h as i32))
+                })
+                .collect();
+            let rows = chart.plotting_area().get_pixel_range().1;
+            let places = place_labels(&pixels, &sizes, (rows.start, rows.end));
+            let origin = plot_area.get_base_pixel();
             for (i, r) in by_time.iter().enumerate() {
-                let colour = if r.exact { RGBColor(36, 58, 115) } else { RGBColor(200, 60, 40) };
-                let at = (r.time.median_ms, 100.0 * r.error_share);
-                let bar = vec![(r.time.min_ms, at.1), (r.time.max_ms, at.1)];
-                chart.draw_series([PathElement::new(bar, colour.stroke_width(1))]).err_text()?;
-                chart.draw_series([Circle::new(at, 4, colour.filled())]).err_text()?;
-                let dy = if i % 2 == 0 { -18 } else { 7 };
-                let number = Text::new(format!("{}", i + 1), (-3, dy), ("sans-serif", 11).into_font());
-                chart.draw_series([EmptyElement::at(at) + number]).err_text()?;
-                let line = format!("{:>2}. {} + {}: {:.1} ms, {:.3}%", i + 1, r.visibility, r.shadows, at.0, at.1);
-                let font = ("sans-serif", 11).into_font().color(&colour);
-                key.draw(&Text::new(line, (4, 24 + 18 * i as i32), font)).err_text()?;
+                let c = if r.exact { exact } else { approximate };
+                let bar = vec![(r.time.min_ms, at[i].1), (r.time.max_ms, at[i].1)];
+                chart.draw_series([PathElement::new(bar, c.stroke_width(1))]).err_text()?;
+                chart.draw_series([Circle::new(at[i], 4, c.filled())]).err_text()?;
+                let ((x, y), moved) = places[i];
+                let (x, y) = (x - origin.0, y - origin.1);
+                if moved {
+                    let (px, py) = (pixels[i].0 - origin.0, pixels[i].1 - origin.1);
+                    let end = (x + sizes[i].0 / 2, if y > py { y } else { y + sizes[i].1 });
+                    plot_area.draw(&PathElement::new(vec![(px, py), end], BLACK.mix(0.35))).err_text()?;
+                }
+                plot_area.draw(&Text::new(format!("{}", i + 1), (x, y), font.clone())).err_text()?;
+                let line =
+                    format!("{:>2}. {} + {}: {:.1} ms, {:.3}%", i + 1, r.visibility, r.shadows, at[i].0, at[i].1);
+                key.draw(&Text::new(line, (4, 24 + 18 * i as i32), ("sans-serif", 12).into_font().color(&c)))
+                    .err_text()?;
             }
+            let note = "blue: exact; vermillion: approximate";
+            key.draw(&Text::new(note, (4, 24 + 18 * at.len() as i32 + 8), ("sans-serif", 12))).err_text()?;
             Ok(())
         }
     }
@@ -371,14 +392,14 @@ mod charts {
     /// Each method's median frame split into its phases, as stacked horizontal bars.
     struct Phases<'a>(&'a [&'a MethodResult]);
 
-    const COLOURS: [RGBColor; 6] = [
-        RGBColor(150, 150, 150),
-        RGBColor(70, 130, 180),
-        RGBColor(200, 60, 40),
-        RGBColor(240, 160, 40),
-        RGBColor(60, 160, 90),
-        RGBColor(140, 90, 170),
-    ];
+    /// The phases' colours, in [`PHASES`]' order: the view in grey, the rest from the
+    /// colour-blind-safe palette.
+    const COLOURS: [RGBColor; 6] =
+        [RGBColor(150, 150, 150), colour_at(0), colour_at(1), colour_at(2), colour_at(3), colour_at(4)];
+
+    const fn colour_at(i: usize) -> RGBColor {
+        crate::study::plot::PALETTE[i]
+    }
 
     fn total(r: &MethodResult) -> f64 {
         PHASES.iter().filter_map(|p| r.step_ms.get(*p)).sum()
@@ -386,22 +407,34 @@ mod charts {
 
     impl Chart for Phases<'_> {
         fn size(&self) -> (u32, u32) {
-            (860, (60 + 22 * self.0.len() as u32).max(120))
+            (960, (60 + 22 * self.0.len() as u32).max(120))
         }
 
         fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
             let longest = self.0.iter().map(|r| total(r)).fold(0.0f64, f64::max).max(1e-3);
-            let (left, right, top) = (230.0, 560.0, 40);
+            // The bars start after the longest name, however long.
+            let name = |r: &MethodResult| format!("{} + {}", r.visibility, r.shadows);
+            let style = ("sans-serif", 12).into_text_style(root);
+            let names = self.0.iter().map(|r| root.estimate_text_size(&name(r), &style).map_or(220, |s| s.0));
+            let left = (names.max().unwrap_or(200) as f64 + 20.0).max(230.0);
+            let (right, top) = (self.size().0 as f64 - left - 70.0, 40);
             let text = |s: String, x: i32, y: i32| Text::new(s, (x, y), ("sans-serif", 12));
             root.draw(&text("median time per phase, ms".into(), 10, 12)).err_text()?;
-            for (k, (p, c)) in PHASES.iter().zip(COLOURS).enumerate() {
-                let x = 260 + 95 * k as i32;
+            // The legend's entries one after another, each as wide as its text: never two on
+            // one another, however long the names.
+            let mut x = left as i32;
+            for (p, c) in PHASES.iter().zip(COLOURS) {
+                let name = p.replace('_', " ");
+                let width = root
+                    .estimate_text_size(&name, &("sans-serif", 12).into_text_style(root))
+                    .map_or(90, |s| s.0 as i32);
                 root.draw(&Rectangle::new([(x, 8), (x + 10, 18)], c.filled())).err_text()?;
-                root.draw(&text(p.replace('_', " "), x + 14, 8)).err_text()?;
+                root.draw(&text(name, x + 14, 8)).err_text()?;
+                x += 14 + width + 18;
             }
             for (i, r) in self.0.iter().enumerate() {
                 let y = top + 22 * i as i32;
-                root.draw(&text(format!("{} + {}", r.visibility, r.shadows), 10, y + 3)).err_text()?;
+                root.draw(&text(name(r), 10, y + 3)).err_text()?;
                 let mut x = left;
                 for (p, c) in PHASES.iter().zip(COLOURS) {
                     let w = r.step_ms.get(*p).copied().unwrap_or(0.0) / longest * right;

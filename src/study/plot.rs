@@ -63,6 +63,62 @@ fn draw_on<DB: DrawingBackend>(chart: &impl Chart, root: &DrawingArea<DB, Shift>
     root.present().err_text()
 }
 
+/// Colours for series on white that colour-blind readers tell apart (Okabe and Ito's
+/// palette, its yellow left out: it is too pale on white), in the order they are used.
+pub(crate) const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),   // blue
+    RGBColor(213, 94, 0),    // vermillion
+    RGBColor(0, 158, 115),   // bluish green
+    RGBColor(230, 159, 0),   // orange
+    RGBColor(204, 121, 167), // reddish purple
+    RGBColor(86, 180, 233),  // sky blue
+    RGBColor(0, 0, 0),       // black
+];
+
+/// The `i`th series' colour (the palette again after seven).
+pub(crate) fn colour(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// Places labels of size `sizes[i]` (pixels) near points `at[i]` (pixels) so that no two
+/// overlap (nor come within a few pixels of another) and none covers a point: each tries
+/// slots above and below its point, stepping
+/// away until one is free, within the rows `inside` (top, bottom: the plotting area).
+/// Returns each label's top-left corner, and whether it had to
+/// move away from its point (then a leader line should join them).
+pub(crate) fn place_labels(at: &[(i32, i32)], sizes: &[(i32, i32)], inside: (i32, i32)) -> Vec<((i32, i32), bool)> {
+    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+    // Boxes keep a gap of `GAP` pixels between them, so that "5" beside "8" never reads "58".
+    const GAP: i32 = 4;
+    let overlaps = |b: (i32, i32, i32, i32), others: &[(i32, i32, i32, i32)]| {
+        let hits_box =
+            others.iter().any(|o| b.0 < o.2 + GAP && o.0 < b.2 + GAP && b.1 < o.3 + GAP / 2 && o.1 < b.3 + GAP / 2);
+        let hits_point = at.iter().any(|&(px, py)| px + 4 > b.0 && px - 4 < b.2 && py + 4 > b.1 && py - 4 < b.3);
+        hits_box || hits_point
+    };
+    let mut out = Vec::with_capacity(at.len());
+    for (&(x, y), &(w, h)) in at.iter().zip(sizes) {
+        let mut chosen = None;
+        for level in 0..12 {
+            let step = 6 + level * (h + 2);
+            for dy in [-(step + h), step] {
+                let b = (x - w / 2, y + dy, x - w / 2 + w, y + dy + h);
+                if b.1 >= inside.0 && b.3 <= inside.1 && !overlaps(b, &placed) {
+                    chosen = Some((b, level > 0));
+                    break;
+                }
+            }
+            if chosen.is_some() {
+                break;
+            }
+        }
+        let (b, moved) = chosen.unwrap_or(((x - w / 2, y - 6 - h, x + w / 2, y - 6), false));
+        placed.push(b);
+        out.push(((b.0, b.1), moved));
+    }
+    out
+}
+
 /// Tick positions for a log axis over `lo..hi`: 1, 2 and 5 times the powers of ten, every
 /// digit where that gives fewer than four, only the powers of ten where it gives more than
 /// ten (plotters alone labels only powers of ten, which leaves a narrow axis bare).
@@ -99,6 +155,24 @@ mod tests {
         fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
             root.draw(&plotters::element::Text::new("ms 1.5", (10, 10), ("sans-serif", 20))).err_text()
         }
+    }
+
+    /// Labels of points that crowd together are spread out until none overlaps another or
+    /// covers a point.
+    #[test]
+    fn crowded_labels_never_overlap() {
+        let at: Vec<(i32, i32)> = (0..8).map(|i| (100 + 3 * i, 200)).collect();
+        let sizes = vec![(14, 11); 8];
+        let placed = place_labels(&at, &sizes, (0, 400));
+        for (i, &((x, y), _)) in placed.iter().enumerate() {
+            for &((u, v), _) in &placed[..i] {
+                assert!(x + 18 <= u || u + 18 <= x || y + 13 <= v || v + 13 <= y, "labels {i} touch");
+            }
+            for &(px, py) in &at {
+                assert!(px + 4 <= x || px - 4 >= x + 14 || py + 4 <= y || py - 4 >= y + 11, "label {i} covers a point");
+            }
+        }
+        assert!(placed.iter().any(|p| p.1), "some had to move away");
     }
 
     #[test]

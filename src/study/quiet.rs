@@ -17,7 +17,8 @@ use std::time::{Duration, Instant};
 /// runs umbra on).
 const TICKS_PER_S: f64 = 100.0;
 
-/// The shortest stretch whose foreign cores are reported: 100 ticks.
+/// The shortest stretch whose foreign cores a report gives: 100 ticks (a shorter row read 0
+/// to 3 cores on a 2-core machine for the same command).
 pub(crate) const MIN_STRETCH: Duration = Duration::from_secs(1);
 
 /// Foreign cores measured from a point in time on.
@@ -27,18 +28,20 @@ pub(crate) struct Monitor {
 }
 
 impl Monitor {
+    /// The foreign cores where the stretch so far is [`MIN_STRETCH`] or longer; `None` for
+    /// a shorter one, whose figure is noise.
+    pub(crate) fn foreign_if_long(&self) -> Option<f64> {
+        (self.start.elapsed() >= MIN_STRETCH).then(|| self.foreign()).flatten()
+    }
+
     /// Starts measuring now.
     pub(crate) fn start() -> Monitor {
         Monitor { start: Instant::now(), ticks: ticks() }
     }
 
     /// The cores other processes used on average since [`Monitor::start`], never below 0;
-    /// `None` where the system does not say, or the stretch is under [`MIN_STRETCH`] (too
-    /// few ticks: a short row read 0 to 3 cores on a 2-core machine for the same command).
+    /// `None` where the system does not say.
     pub(crate) fn foreign(&self) -> Option<f64> {
-        if self.start.elapsed() < MIN_STRETCH {
-            return None;
-        }
         let ((busy0, own0), (busy1, own1)) = (self.ticks?, ticks()?);
         Some(foreign_cores(busy1.saturating_sub(busy0), own1.saturating_sub(own0), self.start.elapsed()))
     }

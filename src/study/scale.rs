@@ -375,12 +375,16 @@ impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
             .draw()
             .err_text()?;
         for (i, (v, s)) in self.o.methods.iter().enumerate() {
-            let colour = Palette99::pick(i).to_rgba();
+            let colour = super::plot::colour(i);
             let mine: Vec<&Point> =
                 positive.iter().copied().filter(|p| p.visibility == v.name() && p.shadows == s.label()).collect();
             let series: Vec<(f64, f64)> = mine.iter().map(|p| (x(p), (self.y)(p))).collect();
-            chart.draw_series(LineSeries::new(series.clone(), colour.stroke_width(2))).err_text()?;
-            chart.draw_series(series.into_iter().map(|p| Circle::new(p, 3, colour.filled()))).err_text()?;
+            // Later series are drawn thinner and their points smaller, so that one lying on
+            // an earlier one (equal values: the legend says so) still shows round it.
+            let under = (self.o.methods.len() - 1 - i) as u32;
+            let (width, radius) = (2 + 3 * under, 3 + 2 * under);
+            chart.draw_series(LineSeries::new(series.clone(), colour.stroke_width(width))).err_text()?;
+            chart.draw_series(series.into_iter().map(|p| Circle::new(p, radius, colour.filled()))).err_text()?;
             if let Some(f) = self.spread {
                 let bars = mine.iter().map(|p| {
                     let (lo, hi) = f(p);
@@ -392,25 +396,37 @@ impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
         Ok(())
     }
 
-    /// The legend's entries: each method's name.
+    /// The legend's entries: each method's name, and, where its values equal an earlier
+    /// method's at every point, which one its line lies on.
     fn entries(&self) -> impl Iterator<Item = String> + '_ {
-        self.o.methods.iter().map(|(v, s)| format!("{v} + {s}"))
+        let values = |v: &VisibilityMethod, s: &ShadowMethod| -> Vec<u64> {
+            let mine = self.points.iter().filter(|p| p.visibility == v.name() && p.shadows == s.label());
+            mine.map(|p| (self.y)(p).to_bits()).collect()
+        };
+        let all: Vec<Vec<u64>> = self.o.methods.iter().map(|(v, s)| values(v, s)).collect();
+        self.o.methods.iter().enumerate().map(move |(i, (v, s))| {
+            let same = (0..i).find(|&j| !all[i].is_empty() && all[j] == all[i]);
+            match same {
+                Some(j) => format!("{v} + {s} (equal to {}, on its line)", j + 1),
+                None => format!("{v} + {s}"),
+            }
+        })
     }
 
     /// The legend's width: room for its longest entry (at most 8 pixels a character at the
     /// legend's 13-pixel type, after the 36 pixels of the colour line), 220 pixels at least.
     fn legend_width(&self) -> u32 {
         let longest = self.entries().map(|e| e.chars().count()).max().unwrap_or(0) as u32;
-        (44 + 8 * longest).max(220)
+        (44 + 8 * (longest + 4)).max(220)
     }
 
     /// The methods' colours beside the plot.
     fn legend<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> std::result::Result<(), String> {
         for (i, entry) in self.entries().enumerate() {
-            let colour = Palette99::pick(i).to_rgba();
+            let colour = super::plot::colour(i);
             let row = 40 + 22 * i as i32;
-            area.draw(&PathElement::new(vec![(8, row), (30, row)], colour.stroke_width(2))).err_text()?;
-            area.draw(&Text::new(entry, (36, row - 7), ("sans-serif", 13))).err_text()?;
+            area.draw(&PathElement::new(vec![(8, row), (30, row)], colour.stroke_width(3))).err_text()?;
+            area.draw(&Text::new(format!("{}. {entry}", i + 1), (36, row - 7), ("sans-serif", 13))).err_text()?;
         }
         if self.spread.is_some() {
             let row = 52 + 22 * self.o.methods.len() as i32;

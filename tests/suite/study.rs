@@ -76,7 +76,11 @@ fn compare_reports_every_method_and_a_valid_page() {
     let about = &json["about"];
     assert_eq!(about["umbra"], env!("CARGO_PKG_VERSION"));
     assert!(about["cores"].as_u64().unwrap() >= 1 && about["date_utc"].as_str().unwrap().starts_with("20"));
-    assert!(about["options"].as_str().unwrap().contains("Crow(VolumeOptions { counting: ZPass"));
+    let options = about["options"].as_str().unwrap();
+    assert!(
+        options.contains("shadow stages: ") && options.contains("crow") && !options.contains("Options {"),
+        "{options}"
+    );
     assert!(html.contains(about["date_utc"].as_str().unwrap()));
     for r in json["results"].as_array().unwrap().iter().filter(|r| r["status"] == "ok") {
         let (lo, mid, hi) =
@@ -188,7 +192,7 @@ fn scale_writes_csv_and_plots() {
     for plot in ["time", "counter"] {
         assert!(std::fs::read_to_string(out.join(format!("{plot}.svg"))).unwrap().starts_with("<svg"));
         let png = image::open(out.join(format!("{plot}.png"))).unwrap().to_rgb8();
-        assert_eq!(png.dimensions(), (860, 480));
+        assert_eq!(png.dimensions().1, 480);
     }
 }
 
@@ -214,4 +218,23 @@ fn unknown_method_names_list_the_known_ones() {
     }
     let e = "painter".parse::<umbra::VisibilityMethod>().unwrap_err().to_string();
     assert!(e.contains("scanline") && e.contains("zbuffer"), "{e}");
+}
+
+/// Series of equal values in scale's charts are noted in the legend (their lines lie on one
+/// another), and the charts draw in the colour-blind-safe palette, with no pale yellow.
+#[test]
+fn scale_notes_series_of_equal_values() {
+    let out = tmp("scale-equal");
+    let methods = vec![
+        (umbra::VisibilityMethod::Scanline, ShadowMethod::None),
+        (umbra::VisibilityMethod::Scanline, "crow".parse().unwrap()),
+        (umbra::VisibilityMethod::ZBuffer, ShadowMethod::None),
+    ];
+    umbra::study::scale::scale(&quads_sweep(&out, vec![1.0, 4.0], methods)).unwrap();
+    let svg = std::fs::read_to_string(out.join("counter.svg")).unwrap();
+    assert!(svg.contains("scanline + crow (equal to 1, on its line)"), "the note is missing");
+    assert!(!svg.contains("zbuffer + none (equal"), "the z-buffer's depth tests differ");
+    let png = image::open(out.join("counter.png")).unwrap().to_rgb8();
+    let yellow = png.pixels().filter(|p| p.0[0] > 200 && p.0[1] > 200 && p.0[2] < 100).count();
+    assert_eq!(yellow, 0, "pale yellow on white");
 }
