@@ -60,6 +60,19 @@ impl Default for RenderOptions {
     }
 }
 
+impl RenderOptions {
+    /// The same options with the shadow stage as its paper publishes it
+    /// ([`ShadowMethod::as_published`], the command line's `--paper`).
+    ///
+    /// ```
+    /// let paper = umbra::RenderOptions::default().as_published();
+    /// assert!(paper.shadows.is_paper());
+    /// ```
+    pub fn as_published(&self) -> RenderOptions {
+        RenderOptions { shadows: self.shadows.as_published(), ..self.clone() }
+    }
+}
+
 /// A rendered frame and what it took.
 #[derive(Debug, Clone)]
 pub struct Rendered {

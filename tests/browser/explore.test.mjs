@@ -106,7 +106,14 @@ async function checkLive(browser, url) {
   await page.locator("#overlay").click({ position: { x: 305.5 * scale, y: 440.5 * scale } });
   await page.waitForFunction(() => /^Pixel \(305, 440\)/.test(document.getElementById("pixel").textContent));
   if (shots) await page.screenshot({ path: join(shots, "explore-crow.png"), fullPage: true });
+  // The "as published" box runs the paper path (Crow 1977) and says so in the title.
+  await page.check("#paper");
+  await page.waitForFunction(() => /crow \(paper\)/.test(document.getElementById("stage-title").textContent), null, { timeout: 60000 });
+  assert.match(await page.getAttribute("#frame", "src"), /paper=1/);
+  await page.uncheck("#paper");
+  await page.waitForFunction(() => !/paper/.test(document.getElementById("stage-title").textContent), null, { timeout: 60000 });
   await page.selectOption("#stage", "williams");
+  assert.ok(await page.isDisabled("#paper"), "williams has no paper path");
   await page.waitForSelector('#stage-panel[data-stage="williams"]', { timeout: 60000 });
   await ready(page);
   assert.match(await page.textContent("#stage-extra"), /A 2048² map, one texel compared per pixel/);
