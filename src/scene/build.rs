@@ -166,6 +166,35 @@ impl SceneBuilder {
 mod tests {
     use super::*;
 
+    /// The builder refuses what the loader refuses: a light at NaN or infinity (which once
+    /// rendered, with the exact stages disagreeing), a camera or a material value that is
+    /// not finite.
+    #[test]
+    fn values_the_loader_refuses_are_refused_by_the_builder_too() {
+        let camera = || Camera::new(DVec3::new(0.0, 1.0, 5.0), DVec3::ZERO);
+        let build = |camera: Camera, light: Light, material: Material| {
+            Scene::builder(camera)
+                .material(material)
+                .light(light)
+                .object(Object::new(Mesh::from_polygons(&[vec![DVec3::X, DVec3::Y, DVec3::Z]])), "m")
+                .build()
+        };
+        let good = || Material::new("m");
+        assert!(build(camera(), Light::point(DVec3::Y * 3.0), good()).is_ok());
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let e = build(camera(), Light::point(DVec3::new(bad, 3.0, 0.0)), good()).unwrap_err().to_string();
+            assert!(e.contains("light 0") && e.contains("finite"), "{e}");
+            let mut light = Light::point(DVec3::Y * 3.0);
+            light.intensity = bad as f32;
+            assert!(build(camera(), light, good()).is_err());
+            let eye = Camera { eye: DVec3::new(0.0, bad, 5.0), ..camera() };
+            assert!(build(eye, Light::point(DVec3::Y * 3.0), good()).is_err());
+            let mut m = good();
+            m.kd = bad as f32;
+            assert!(build(camera(), Light::point(DVec3::Y * 3.0), m).is_err());
+        }
+    }
+
     #[test]
     fn an_unknown_material_name_is_an_error_naming_it() {
         let tri = Mesh::from_polygons(&[vec![DVec3::ZERO, DVec3::X, DVec3::Y]]);

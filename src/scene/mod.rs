@@ -339,6 +339,24 @@ impl Light {
     }
 
     fn validate(&self) -> std::result::Result<(), String> {
+        let finite = match &self.kind {
+            LightKind::Point { position } => position.is_finite(),
+            LightKind::Directional { direction } => direction.is_finite(),
+            LightKind::Spot { position, direction, cutoff, exponent } => {
+                position.is_finite() && direction.is_finite() && cutoff.is_finite() && exponent.is_finite()
+            }
+            LightKind::Area { corner, edge_u, edge_v, .. } => {
+                corner.is_finite() && edge_u.is_finite() && edge_v.is_finite()
+            }
+        };
+        if !finite || !self.color.is_finite() || !self.intensity.is_finite() {
+            return Err("light position, direction, edges, colour and intensity must be finite".into());
+        }
+        if let LightKind::Spot { exponent, .. } = self.kind {
+            if exponent < 0.0 {
+                return Err(format!("spot exponent must be >= 0, got {exponent}"));
+            }
+        }
         let a = self.attenuation;
         if a.iter().any(|&c| c.is_nan() || c < 0.0) || a.iter().all(|&c| c == 0.0) {
             return Err(format!("attenuation {a:?} must be >= 0 and not all zero"));
@@ -517,6 +535,9 @@ impl Scene {
         }
         if materials.is_empty() {
             materials.push(Material::new("default"));
+        }
+        for m in &materials {
+            m.validate().map_err(|e| Error::InvalidOption(format!("material '{}': {e}", m.name)))?;
         }
         for (i, o) in objects.iter().enumerate() {
             if o.material >= materials.len() {
