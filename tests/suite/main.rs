@@ -12,6 +12,7 @@ mod explore;
 mod fuzz;
 mod loading;
 mod paper;
+mod readme;
 mod reflection;
 mod shading;
 mod shadows;
