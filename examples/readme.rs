@@ -25,7 +25,7 @@ fn first() -> Result<(), umbra::Error> {
         ..RenderOptions::default()
     };
     let out = render(&scene, &options)?;
-    out.frame.save_png("cornell.png".as_ref(), None)?;
+    out.frame.save_png("cornell.png", None)?;
     println!("{:?}", out.stats.visibility_counters);
     Ok(())
 }

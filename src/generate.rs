@@ -33,7 +33,7 @@ fn camera(eye: DVec3, target: DVec3, width: u32, height: u32) -> Camera {
 }
 
 /// Appends an axis-aligned box `lo..hi` to `mesh`, as 6 quads or 12 triangles.
-fn add_box(mesh: &mut Mesh, lo: DVec3, hi: DVec3, triangles: bool) {
+pub(crate) fn add_box(mesh: &mut Mesh, lo: DVec3, hi: DVec3, triangles: bool) {
     let c = |i: usize| {
         DVec3::new(
             if i & 1 == 0 { lo.x } else { hi.x },

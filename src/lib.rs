@@ -71,6 +71,9 @@ pub use error::{Error, FileLoc, Result};
 pub use frame::{check_gamma, Frame, PixelCounters, BACKGROUND, GAMMA_RANGE};
 /// The vector types the API takes and gives (points, directions, colours).
 pub use glam;
+/// The image types the API gives ([`Frame::color_image`], `study::compare::diff`): use
+/// these, whatever version of `image` a program has of its own.
+pub use image;
 pub use progress::{Progress, ProgressFn};
 pub use reflection::ReflectionMethod;
 pub use render::{render, RenderOptions, Rendered, Renderer};

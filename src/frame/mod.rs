@@ -180,7 +180,8 @@ impl Frame {
     }
 
     /// Writes the colour image as PNG (see [`check_gamma`] for `gamma`).
-    pub fn save_png(&self, path: &Path, gamma: Option<f32>) -> Result<()> {
+    pub fn save_png(&self, path: impl AsRef<Path>, gamma: Option<f32>) -> Result<()> {
+        let path = path.as_ref();
         if let Some(g) = gamma {
             check_gamma(g)?;
         }
@@ -191,7 +192,8 @@ impl Frame {
     /// when a mirror was seen, and, when the
     /// frame has per-pixel counters, `depth_complexity.png`, `span_splits.png` and
     /// `shadow_tests.png` in false colour with a legend.
-    pub fn save_aovs(&self, dir: &Path) -> Result<()> {
+    pub fn save_aovs(&self, dir: impl AsRef<Path>) -> Result<()> {
+        let dir = dir.as_ref();
         std::fs::create_dir_all(dir).map_err(|e| Error::Write { path: dir.to_owned(), source: e })?;
         self.save(self.id_image().into(), &dir.join("id.png"))?;
         self.save(self.id_view_image().into(), &dir.join("id_view.png"))?;

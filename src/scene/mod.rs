@@ -405,6 +405,44 @@ pub struct Face {
 }
 
 impl Mesh {
+    /// An axis-aligned box from corner `lo` to corner `hi`: six quads, wound counter-clockwise
+    /// seen from outside (a closed solid).
+    ///
+    /// ```
+    /// use umbra::{glam::DVec3, Mesh};
+    /// let cube = Mesh::cuboid(DVec3::ZERO, DVec3::ONE);
+    /// assert_eq!((cube.positions.len(), cube.faces.len()), (8, 6));
+    /// ```
+    pub fn cuboid(lo: DVec3, hi: DVec3) -> Mesh {
+        let mut mesh = Mesh::default();
+        crate::generate::add_box(&mut mesh, lo, hi, false);
+        mesh
+    }
+
+    /// One quad with corners `corners`, in order (its front is the side they run
+    /// counter-clockwise round).
+    pub fn quad(corners: [DVec3; 4]) -> Mesh {
+        Mesh::from_polygons(&[corners.to_vec()])
+    }
+
+    /// A flat grid of `nu × nv` quads from `origin` along `u` and `v` (the whole grid's
+    /// edges), front on the side `u × v` points to: a floor or a wall made of many polygons.
+    pub fn grid(origin: DVec3, u: DVec3, v: DVec3, nu: u32, nv: u32) -> Mesh {
+        let (nu, nv) = (nu.max(1), nv.max(1));
+        let at = |i: u32, j: u32| origin + u * (i as f64 / nu as f64) + v * (j as f64 / nv as f64);
+        let quads: Vec<Vec<DVec3>> = (0..nv)
+            .flat_map(|j| (0..nu).map(move |i| (i, j)))
+            .map(|(i, j)| vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)])
+            .collect();
+        Mesh::from_polygons(&quads)
+    }
+
+    /// A UV sphere round `centre` of radius `r`, as near `triangles` triangles as a UV sphere
+    /// has, with vertex normals (a closed solid; [`crate::generate::sphere_mesh`]).
+    pub fn sphere(centre: DVec3, r: f64, triangles: u32) -> Mesh {
+        crate::generate::sphere_mesh(centre, r, triangles)
+    }
+
     /// A mesh of separate polygons (the `polygons = [...]` form).
     pub fn from_polygons(polys: &[Vec<DVec3>]) -> Mesh {
         let mut mesh = Mesh::default();
@@ -426,6 +464,38 @@ pub struct Transform {
     pub rotate: DVec3,
     /// Translation.
     pub translate: DVec3,
+}
+
+impl Transform {
+    /// A move by `t`.
+    pub fn translation(t: DVec3) -> Transform {
+        Transform { translate: t, ..Transform::default() }
+    }
+
+    /// A scale by `s` per axis.
+    pub fn scaling(s: DVec3) -> Transform {
+        Transform { scale: s, ..Transform::default() }
+    }
+
+    /// A rotation by `degrees` about X, then Y, then Z.
+    pub fn rotation(degrees: DVec3) -> Transform {
+        Transform { rotate: degrees, ..Transform::default() }
+    }
+
+    /// The same transform, moved by `t` as well (after scaling and rotating).
+    pub fn translated(self, t: DVec3) -> Transform {
+        Transform { translate: t, ..self }
+    }
+
+    /// The same transform, scaled by `s` first.
+    pub fn scaled(self, s: DVec3) -> Transform {
+        Transform { scale: s, ..self }
+    }
+
+    /// The same transform, rotated by `degrees` (after scaling, before moving).
+    pub fn rotated(self, degrees: DVec3) -> Transform {
+        Transform { rotate: degrees, ..self }
+    }
 }
 
 impl Default for Transform {

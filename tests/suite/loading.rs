@@ -250,3 +250,30 @@ fn the_api_keeps_the_loaders_invariants() {
     let f = umbra::render(&s, &umbra::RenderOptions::default()).unwrap().frame;
     assert!(f.light_image(0).is_some() && f.light_image(1).is_none());
 }
+
+/// The mesh and transform constructors make what a scene file would: a closed box, a quad,
+/// a grid of quads and a sphere, placed by a transform, render and load their polygons.
+#[test]
+fn mesh_and_transform_constructors_build_scenes() {
+    use umbra::glam::DVec3;
+    use umbra::scene::Transform;
+    use umbra::{Camera, Light, Material, Mesh, Object, Scene};
+    let grid = Mesh::grid(DVec3::new(-3.0, 0.0, 3.0), DVec3::new(6.0, 0.0, 0.0), DVec3::new(0.0, 0.0, -6.0), 4, 3);
+    assert_eq!(grid.faces.len(), 12);
+    let cube = Object::new(Mesh::cuboid(DVec3::ZERO, DVec3::ONE))
+        .placed(Transform::translation(DVec3::new(-1.5, 0.0, 0.0)).scaled(DVec3::splat(0.8)));
+    let scene = Scene::builder(Camera::new(DVec3::new(0.0, 3.0, 6.0), DVec3::ZERO))
+        .material(Material::new("m"))
+        .light(Light::point(DVec3::new(1.0, 5.0, 2.0)))
+        .object(Object::new(grid), "m")
+        .object(cube, "m")
+        .object(Object::new(Mesh::sphere(DVec3::new(1.0, 0.6, 0.0), 0.6, 200)), "m")
+        .object(Object::new(Mesh::quad([DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y, DVec3::ZERO])), "m")
+        .build()
+        .unwrap();
+    assert_eq!(scene.polygons().len(), 12 + 6 + 224 + 1);
+    let (lo, hi) = scene.bounds().unwrap();
+    assert!((lo.x - -3.0).abs() < 1e-12 && (hi.x - 3.0).abs() < 1e-12, "{lo} {hi}");
+    // The cube went where its transform put it: its top corner at 0.8 high.
+    assert!(scene.vertices().iter().any(|v| (*v - DVec3::new(-0.7, 0.8, 0.8)).length() < 1e-12));
+}
