@@ -362,6 +362,7 @@ impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
         YC: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
         let (_, x) = x_axis(self.o);
+        let same = self.equal_to_earlier();
         chart
             .configure_mesh()
             .light_line_style(TRANSPARENT)
@@ -379,9 +380,9 @@ impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
             let mine: Vec<&Point> =
                 positive.iter().copied().filter(|p| p.visibility == v.name() && p.shadows == s.label()).collect();
             let series: Vec<(f64, f64)> = mine.iter().map(|p| (x(p), (self.y)(p))).collect();
-            // Later series are drawn thinner and their points smaller, so that one lying on
-            // an earlier one (equal values: the legend says so) still shows round it.
-            let under = (self.o.methods.len() - 1 - i) as u32;
+            // A series that later ones lie on (equal values: the legend says so) is drawn
+            // thicker, one step for each, so that it still shows round them.
+            let under = same.iter().skip(i + 1).filter(|&&j| j == Some(i)).count() as u32;
             let (width, radius) = (2 + 3 * under, 3 + 2 * under);
             chart.draw_series(LineSeries::new(series.clone(), colour.stroke_width(width))).err_text()?;
             chart.draw_series(series.into_iter().map(|p| Circle::new(p, radius, colour.filled()))).err_text()?;
@@ -396,19 +397,29 @@ impl<Y: Fn(&Point) -> f64> Plot<'_, Y> {
         Ok(())
     }
 
-    /// The legend's entries: each method's name, and, where its values equal an earlier
-    /// method's at every point, which one its line lies on.
-    fn entries(&self) -> impl Iterator<Item = String> + '_ {
+    /// For each method, the first earlier one whose values it equals at every point (its
+    /// line lies on that one's).
+    fn equal_to_earlier(&self) -> Vec<Option<usize>> {
         let values = |v: &VisibilityMethod, s: &ShadowMethod| -> Vec<u64> {
             let mine = self.points.iter().filter(|p| p.visibility == v.name() && p.shadows == s.label());
             mine.map(|p| (self.y)(p).to_bits()).collect()
         };
         let all: Vec<Vec<u64>> = self.o.methods.iter().map(|(v, s)| values(v, s)).collect();
+        (0..all.len()).map(|i| (0..i).find(|&j| !all[i].is_empty() && all[j] == all[i])).collect()
+    }
+
+    /// The legend's entries: each method's name (a paper path's with " (paper)"), and, where
+    /// its values equal an earlier method's at every point, which one its line lies on.
+    fn entries(&self) -> impl Iterator<Item = String> + '_ {
+        let same = self.equal_to_earlier();
         self.o.methods.iter().enumerate().map(move |(i, (v, s))| {
-            let same = (0..i).find(|&j| !all[i].is_empty() && all[j] == all[i]);
-            match same {
-                Some(j) => format!("{v} + {s} (equal to {}, on its line)", j + 1),
-                None => format!("{v} + {s}"),
+            let mine = || self.points.iter().filter(|p| p.visibility == v.name() && p.shadows == s.label());
+            if mine().all(|p| (self.y)(p) <= 0.0) {
+                return format!("{v} + {} (zero everywhere: not drawn)", s.label());
+            }
+            match same[i] {
+                Some(j) => format!("{v} + {} (equal to {}, on its line)", s.label(), j + 1),
+                None => format!("{v} + {}", s.label()),
             }
         })
     }
