@@ -68,7 +68,7 @@ pub mod view;
 pub mod visibility;
 
 pub use error::{Error, FileLoc, Result};
-pub use frame::{check_gamma, Frame, PixelCounters, BACKGROUND, GAMMA_RANGE};
+pub use frame::{check_gamma, Frame, PixelCounters, ShadeClass, BACKGROUND, GAMMA_RANGE};
 /// The vector types the API takes and gives (points, directions, colours).
 pub use glam;
 /// The image types the API gives ([`Frame::color_image`], `study::compare::diff`): use

@@ -331,6 +331,12 @@ fn frame_pass(
     }
     stats.time_ms.insert("shadow_walk", pass * walk_share);
     stats.time_ms.insert("shading", pass * (1.0 - walk_share));
+    // Seed 000's umbra and penumbra of the area lights, counted over the visible pixels.
+    if frame.light_samples.iter().any(|&n| n > 1) {
+        let (umbra, penumbra) = frame.umbra_and_penumbra();
+        stats.shadow_counters.add("umbra_pixels", umbra);
+        stats.shadow_counters.add("penumbra_pixels", penumbra);
+    }
     stats.time_ms.insert("total", ms(start.elapsed()));
     // Empty unless asked for: the stages keep outlines only then (`ShadowContext::keep_outlines`).
     let outlines = shadows.outlines();

@@ -55,6 +55,19 @@ pub struct PixelCounters {
     pub shadow_tests: Vec<u32>,
 }
 
+/// Where a visible point stands against an area light (seed 000): the umbra, where no point
+/// of the light is seen; the penumbra, where some are; or fully lit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadeClass {
+    /// No sample of the light reaches the point.
+    Umbra,
+    /// Some samples reach it, not all.
+    Penumbra,
+    /// Every sample reaches it.
+    Lit,
+}
+
 impl Frame {
     /// A frame of background pixels.
     pub fn new(width: u32, height: u32, lights: usize, background: Vec3) -> Frame {
@@ -150,6 +163,62 @@ impl Frame {
         }))
     }
 
+    /// Where pixel `i` stands against light `k`'s samples (seed 000's umbra and penumbra,
+    /// `docs/scene-format.md` §6): `None` on background, else umbra (no sample lights the
+    /// visible point), penumbra (some do) or lit (all do). A sample counts as lighting the
+    /// point by its share of the lit fraction, so a fraction within half a sample's share of
+    /// 0 is umbra and within half a share of 1 is lit (the stages' sums of `1/n` round).
+    pub fn shade_class(&self, k: usize, i: usize) -> Option<ShadeClass> {
+        if self.id.get(i).is_none_or(|&id| id == BACKGROUND) {
+            return None;
+        }
+        let n = self.light_samples.get(k).copied().unwrap_or(1).max(1) as f32;
+        let f = *self.light.get(k)?.get(i)?;
+        let half = 0.5 / n;
+        Some(if f <= half {
+            ShadeClass::Umbra
+        } else if f >= 1.0 - half {
+            ShadeClass::Lit
+        } else {
+            ShadeClass::Penumbra
+        })
+    }
+
+    /// The visible pixels in the umbra and in the penumbra of the area lights (more than
+    /// one sample), summed over them.
+    pub(crate) fn umbra_and_penumbra(&self) -> (u64, u64) {
+        use rayon::prelude::*;
+        let areas: Vec<usize> =
+            (0..self.light.len()).filter(|&k| self.light_samples.get(k).is_some_and(|&n| n > 1)).collect();
+        (0..self.id.len())
+            .into_par_iter()
+            .map(|i| {
+                areas.iter().fold((0, 0), |(u, p), &k| match self.shade_class(k, i) {
+                    Some(ShadeClass::Umbra) => (u + 1, p),
+                    Some(ShadeClass::Penumbra) => (u, p + 1),
+                    _ => (u, p),
+                })
+            })
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+    }
+
+    /// `umbra<k>.png` for an area light `k` (more than one sample): 8-bit grey, 0 umbra, 128
+    /// penumbra, 255 lit, and 0 on background (which `id.png` tells apart); `None` for a
+    /// light of one sample, which has no penumbra, or no light `k`.
+    pub fn umbra_image(&self, k: usize) -> Option<image::GrayImage> {
+        if self.light_samples.get(k).copied().unwrap_or(1) <= 1 || k >= self.light.len() {
+            return None;
+        }
+        Some(image::GrayImage::from_fn(self.width, self.height, |x, y| {
+            let v = match self.shade_class(k, (y * self.width + x) as usize) {
+                None | Some(ShadeClass::Umbra) => 0,
+                Some(ShadeClass::Penumbra) => 128,
+                Some(ShadeClass::Lit) => 255,
+            };
+            image::Luma([v])
+        }))
+    }
+
     /// Draws polygons over a colour image: tinted inside (by the even-odd rule, with the
     /// shared scan converter) and outlined.
     pub fn draw_outlines(img: &mut image::RgbImage, rings: &[Vec<glam::DVec2>], color: [u8; 3]) {
@@ -188,8 +257,9 @@ impl Frame {
         self.save(self.color_image(gamma).into(), path)
     }
 
-    /// Writes `id.png` and `light<k>.png` into `dir` (created if missing), `mirror_id.png`
-    /// when a mirror was seen, and, when the
+    /// Writes `id.png` and `light<k>.png` into `dir` (created if missing), `umbra<k>.png`
+    /// for each area light ([`Frame::umbra_image`]), `mirror_id.png` when a mirror was seen,
+    /// and, when the
     /// frame has per-pixel counters, `depth_complexity.png`, `span_splits.png` and
     /// `shadow_tests.png` in false colour with a legend.
     pub fn save_aovs(&self, dir: impl AsRef<Path>) -> Result<()> {
@@ -200,6 +270,9 @@ impl Frame {
         for k in 0..self.light.len() {
             if let Some(img) = self.light_image(k) {
                 self.save(img.into(), &dir.join(format!("light{k}.png")))?;
+            }
+            if let Some(img) = self.umbra_image(k) {
+                self.save(img.into(), &dir.join(format!("umbra{k}.png")))?;
             }
         }
         if let Some(m) = &self.mirror_id {

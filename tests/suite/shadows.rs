@@ -821,3 +821,35 @@ fn zfail_closes_its_volumes_at_a_far_plane_or_at_infinity() {
         }
     }
 }
+
+/// Seed 000's umbra and penumbra of an area light: `umbra<k>.png` exists for the area light
+/// only, reads 0 where no sample lights the point, 255 where all do and 128 between, and
+/// the counters count the same pixels (`scenes/lights.toml`: light 3 is a 4×4 area light).
+#[test]
+fn area_lights_have_an_umbra_and_a_penumbra() {
+    let scene = load_scaled(&"scenes/lights.toml".into(), 320);
+    let out = umbra::render(&scene, &umbra::RenderOptions::default()).unwrap();
+    let f = &out.frame;
+    assert!((0..3).all(|k| f.umbra_image(k).is_none()), "point, directional and spot lights have none");
+    let img = f.umbra_image(3).expect("the area light's");
+    let (mut umbra, mut penumbra) = (0u64, 0u64);
+    for (i, p) in img.pixels().enumerate() {
+        let lit = f.light[3][i];
+        match p.0[0] {
+            0 if f.id[i] != umbra::BACKGROUND => {
+                assert!(lit < 0.5 / 16.0, "pixel {i}: umbra but lit {lit}");
+                umbra += 1;
+            }
+            128 => {
+                assert!(lit > 0.5 / 16.0 && lit < 1.0 - 0.5 / 16.0, "pixel {i}: penumbra but lit {lit}");
+                penumbra += 1;
+            }
+            255 => assert!(lit > 1.0 - 0.5 / 16.0, "pixel {i}: lit but {lit}"),
+            0 => {}
+            v => panic!("pixel {i}: {v} is no class"),
+        }
+    }
+    assert!(umbra > 100 && penumbra > 100, "{umbra} umbra, {penumbra} penumbra pixels");
+    let c = &out.stats.shadow_counters;
+    assert_eq!((c.get("umbra_pixels"), c.get("penumbra_pixels")), (umbra, penumbra));
+}
