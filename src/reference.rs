@@ -140,6 +140,88 @@ impl<'a> Reference<'a> {
     }
 }
 
+/// The exact lit fraction of area light `light` at point `p` of polygon `poly`
+/// (`docs/scene-format.md` §3, the area-light rule): the area of the points Q of the light's
+/// parallelogram for which `N·(Q − P)` and `N·(eye − P)` are non-zero and of one sign and no
+/// casting polygon other than `poly`'s face crosses the open segment PQ, over the light's
+/// area. The limit of the grid's fraction as its samples grow.
+///
+/// Brute force, in f64, step by step: the light is taken as the unit square of its own
+/// coordinates `(a, b)` (`corner + a·edge_u + b·edge_v`: an affine map, so areas keep their
+/// ratio); it is cut by the plane of `poly` to the side the eye sees; then every casting
+/// polygon of another face is cut to the part between P and the light and projected from P
+/// onto the light's plane ([`crate::shadow`]'s projection, the one Bouknight-Kelley uses),
+/// and that shadow is subtracted from what is left, with Weiler and Atherton's clipper. A
+/// light that is not an area light gives `None`, as does a clip that fails.
+///
+/// ```
+/// use umbra::glam::DVec3;
+/// use umbra::{Camera, Light, Material, Mesh, Object, Scene};
+/// // A 2×2 light at height 2 over the origin, a 0.5×0.5 occluder at height 1: seen from the
+/// // origin its shadow on the light's plane is a 1×1 square, a quarter of the light.
+/// let occluder = Mesh::quad([
+///     DVec3::new(-0.25, 1.0, -0.25), DVec3::new(-0.25, 1.0, 0.25),
+///     DVec3::new(0.25, 1.0, 0.25), DVec3::new(0.25, 1.0, -0.25),
+/// ]);
+/// let floor = Mesh::quad([
+///     DVec3::new(-3.0, 0.0, -3.0), DVec3::new(-3.0, 0.0, 3.0),
+///     DVec3::new(3.0, 0.0, 3.0), DVec3::new(3.0, 0.0, -3.0),
+/// ]);
+/// let light = Light::area(DVec3::new(-1.0, 2.0, -1.0), DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.0, 0.0, 2.0), [4, 4]);
+/// let scene = Scene::builder(Camera::new(DVec3::new(0.0, 4.0, 6.0), DVec3::ZERO))
+///     .material(Material::new("m"))
+///     .light(light)
+///     .object(Object::new(floor), "m")
+///     .object(Object::new(occluder), "m")
+///     .build()?;
+/// let f = umbra::reference::exact_fraction(&scene, 0, DVec3::ZERO, 0).unwrap();
+/// assert!((f - 0.75).abs() < 1e-12, "{f}");
+/// # Ok::<(), umbra::Error>(())
+/// ```
+pub fn exact_fraction(scene: &Scene, light: usize, p: glam::DVec3, poly: usize) -> Option<f64> {
+    use crate::geometry::weiler_atherton::{clip, Region};
+    use crate::scene::LightKind;
+    use glam::{DVec2, DVec3};
+    let LightKind::Area { corner, edge_u, edge_v, .. } = scene.lights.get(light)?.kind else { return None };
+    let polygon = scene.polygons.get(poly)?;
+    let eye = View::new(&scene.camera).eye;
+    // The light's own coordinates: Q = corner + a·u + b·v, and back.
+    let normal = edge_u.cross(edge_v);
+    let to_ab = |q: DVec3| {
+        let d = q - corner;
+        let (uu, uv, vv) = (edge_u.dot(edge_u), edge_u.dot(edge_v), edge_v.dot(edge_v));
+        let (du, dv) = (d.dot(edge_u), d.dot(edge_v));
+        let det = uu * vv - uv * uv;
+        DVec2::new((du * vv - dv * uv) / det, (dv * uu - du * uv) / det)
+    };
+    // Step 1: the unit square cut by the plane of `poly`, to the side the eye sees.
+    let seen = polygon.plane.distance(eye).signum();
+    let side = |ab: DVec2| seen * polygon.plane.distance(corner + edge_u * ab.x + edge_v * ab.y);
+    let square = vec![DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+    let mut lit = Vec::new();
+    crate::geometry::clip_polygon(&square, side, &mut lit);
+    if lit.len() < 3 || seen == 0.0 {
+        return Some(0.0);
+    }
+    let mut region = Region::from_ring(lit);
+    // Step 2: each other face's casting polygons' shadows from P on the light, subtracted.
+    let rect = [corner, corner + edge_u, corner + edge_u + edge_v, corner + edge_v];
+    let plane = crate::geometry::Plane::new(normal.normalize(), corner);
+    let target = crate::shadow::projection_target(plane, rect, p);
+    let mut proj = crate::shadow::Projector::default();
+    for (i, g) in scene.polygons.iter().enumerate() {
+        if g.face == polygon.face || !scene.casts_shadows(i) || !proj.project(scene.verts(i), &target) {
+            continue;
+        }
+        let shadow = Region::from_ring(proj.shadow.iter().map(|&q| to_ab(q)).collect());
+        region = clip(&region, &shadow).ok()?.outside;
+        if region.rings.is_empty() {
+            return Some(0.0);
+        }
+    }
+    Some(region.area().abs().min(1.0))
+}
+
 /// The reference for planar mirrors: for each pixel whose visible polygon is a mirror seen from the front, the
 /// face id the ray reflected there sees first (one bounce, by ray casting), else background.
 pub fn mirror_ids(scene: &Scene) -> Vec<u32> {

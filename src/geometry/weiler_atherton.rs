@@ -89,7 +89,6 @@ impl Region {
     }
 
     /// Its area (even-odd: holes subtract).
-    #[cfg(test)]
     pub fn area(&self) -> f64 {
         oriented(self).iter().map(|r| signed_area(r)).sum::<f64>()
     }

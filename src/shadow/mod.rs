@@ -27,6 +27,18 @@ use planar::Planar;
 pub(crate) use ray_cast::blocked;
 use ray_cast::RayCastShadows;
 pub use soft_edges::{Blur, SoftEdges};
+
+/// A light's projection target for [`crate::reference::exact_fraction`]: the plane and the
+/// rectangle `rect` of it, seen from the point `from` (projection from a point, as from a
+/// point light).
+pub(crate) fn projection_target(
+    plane: crate::geometry::Plane,
+    rect: [glam::DVec3; 4],
+    from: glam::DVec3,
+) -> projection::Target {
+    projection::Target::new(plane, rect, LightSample::Point(from))
+}
+pub(crate) use projection::Projector;
 use stencil_volume::StencilVolume;
 pub use volumes::Counting;
 use williams::Williams;

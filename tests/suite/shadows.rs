@@ -853,3 +853,69 @@ fn area_lights_have_an_umbra_and_a_penumbra() {
     let c = &out.stats.shadow_counters;
     assert_eq!((c.get("umbra_pixels"), c.get("penumbra_pixels")), (umbra, penumbra));
 }
+
+/// The exact lit fraction of an area light (`umbra::reference::exact_fraction`) on hand-made
+/// cases: a square occluder centred under a square light hides a quarter of it; moved so
+/// that half its shadow falls beside the light it hides an eighth; a wall whose plane cuts
+/// the light in half sees half of it. And it is the limit of the grid's fraction: 64×64
+/// samples come within 2% of it at every point tried, 4×4 samples much further off.
+#[test]
+fn the_exact_area_fraction_on_hand_cases_and_as_the_grids_limit() {
+    use umbra::glam::DVec3;
+    use umbra::reference::exact_fraction;
+    use umbra::{Camera, Light, Material, Mesh, Object};
+    let square = |x0: f64, x1: f64, y: f64, z0: f64, z1: f64| {
+        Mesh::quad([DVec3::new(x0, y, z0), DVec3::new(x0, y, z1), DVec3::new(x1, y, z1), DVec3::new(x1, y, z0)])
+    };
+    let build = |occluder: Mesh, samples: u32| {
+        let light = Light::area(DVec3::new(-1.0, 2.0, -1.0), DVec3::X * 2.0, DVec3::Z * 2.0, [samples, samples]);
+        let wall = Mesh::quad([
+            DVec3::new(0.0, 0.0, -3.0),
+            DVec3::new(0.0, 3.0, -3.0),
+            DVec3::new(0.0, 3.0, -2.5),
+            DVec3::new(0.0, 0.0, -2.5),
+        ]);
+        Scene::builder(Camera::new(DVec3::new(3.0, 4.0, 6.0), DVec3::ZERO))
+            .material(Material::new("m"))
+            .light(light)
+            .object(Object::new(square(-3.0, 3.0, 0.0, -3.0, 3.0)), "m")
+            .object(Object::new(occluder), "m")
+            .object(Object::new(wall), "m")
+            .build()
+            .unwrap()
+    };
+    let centred = build(square(-0.25, 0.25, 1.0, -0.25, 0.25), 4);
+    let f = |s: &Scene, p: DVec3, poly: usize| exact_fraction(s, 0, p, poly).unwrap();
+    assert!((f(&centred, DVec3::ZERO, 0) - 0.75).abs() < 1e-12);
+    let aside = build(square(0.25, 0.75, 1.0, -0.25, 0.25), 4);
+    assert!((f(&aside, DVec3::ZERO, 0) - 0.875).abs() < 1e-12);
+    // The wall at x = 0 faces +x or -x; the eye at x = 3 sees its +x side: half the light.
+    assert!((f(&centred, DVec3::new(0.0, 1.0, -2.75), 2) - 0.5).abs() < 1e-12);
+    // The grid's fraction tends to it.
+    let fine = build(square(-0.3, 0.45, 0.8, -0.2, 0.6), 64);
+    let coarse = build(square(-0.3, 0.45, 0.8, -0.2, 0.6), 4);
+    let grid = |s: &Scene, p: DVec3| {
+        let samples = s.lights()[0].samples();
+        let plane = &s.polygons()[0].plane;
+        let lit = samples.iter().filter(|&&q| {
+            let umbra::scene::LightSample::Point(q) = q else { return false };
+            // The occluder (polygon 1) is the only caster between the floor and the light.
+            let v = s.vertices();
+            let o = &s.polygons()[1];
+            let quad: Vec<DVec3> = v[o.start as usize..(o.start + o.len) as usize].to_vec();
+            let (n, d) = (o.plane.n, o.plane.d);
+            let t = -(n.dot(p) + d) / n.dot(q - p);
+            let x = p + (q - p) * t;
+            let inside = (0..4).all(|k| (quad[(k + 1) % 4] - quad[k]).cross(x - quad[k]).dot(n) >= 0.0);
+            plane.distance(q) > 0.0 && !(t > 0.0 && t < 1.0 && inside)
+        });
+        lit.count() as f64 / samples.len() as f64
+    };
+    let mut far = 0;
+    for p in [DVec3::ZERO, DVec3::new(0.3, 0.0, 0.2), DVec3::new(-0.4, 0.0, 0.5), DVec3::new(0.8, 0.0, -0.6)] {
+        let exact = f(&fine, p, 0);
+        assert!((grid(&fine, p) - exact).abs() < 0.02, "at {p}: 64×64 {} against exact {exact}", grid(&fine, p));
+        far += usize::from((grid(&coarse, p) - exact).abs() > 0.005);
+    }
+    assert!(far > 0, "4×4 samples matched the exact fraction everywhere");
+}
