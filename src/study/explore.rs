@@ -295,6 +295,21 @@ fn summary(scene: &Scene, r: &Request, got: &Rendered, reference: &Rendered, out
     }
     let outlines: Vec<Vec<[f64; 2]>> =
         outlines.iter().take(MAX_OUTLINES).map(|ring| ring.iter().map(|p| p.to_array()).collect()).collect();
+    // Seed 000's penumbra of the first area light (its umbra shows dark in the frame).
+    let area = (0..f.light.len()).find(|&k| f.light_samples.get(k).is_some_and(|&n| n > 1));
+    let (mut penumbra, mut umbra_total, mut penumbra_total) = (Vec::new(), 0usize, 0usize);
+    for (i, k) in area.into_iter().flat_map(|k| (0..f.id.len()).map(move |i| (i, k))) {
+        match f.shade_class(k, i) {
+            Some(crate::ShadeClass::Umbra) => umbra_total += 1,
+            Some(crate::ShadeClass::Penumbra) => {
+                penumbra_total += 1;
+                if penumbra.len() < MAX_DIFFERS {
+                    penumbra.push([(i % w) as u32, (i / w) as u32]);
+                }
+            }
+            _ => {}
+        }
+    }
     json!({
         "shadows": r.shadows.label(),
         "exact": r.shadows.is_exact(),
@@ -304,6 +319,7 @@ fn summary(scene: &Scene, r: &Request, got: &Rendered, reference: &Rendered, out
         "outlines": outlines,
         "outlines_total": outlines.len(),
         "differs": { "wrong": wrong, "wrong_total": wrong_total, "ties": ties, "ties_total": ties_total },
+        "penumbra": { "light": area, "pixels": penumbra, "penumbra_total": penumbra_total, "umbra_total": umbra_total },
         "lights": scene.lights().iter().map(|l| json!({ "kind": kind_name(&l.kind), "at": at(&l.kind) })).collect::<Vec<_>>(),
     })
 }

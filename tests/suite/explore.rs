@@ -171,3 +171,22 @@ fn the_command_stops_on_a_bad_scene_before_serving() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("WIDTHxHEIGHT"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The explorer's frame summary carries seed 000's penumbra of the first area light (the
+/// page draws it with its "penumbra" box): on the lights scene, light 3 (4×4 samples), with
+/// the same counts as the render's counters.
+#[test]
+fn the_frame_summary_carries_the_penumbra_of_an_area_light() {
+    let scene = umbra::Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/lights.toml")).unwrap();
+    let explorer = umbra::study::explore::Explorer::new(scene, "lights");
+    let r = explorer.handle("/api/frame?shadows=bouknight-kelley&width=160&height=120");
+    assert_eq!(r.status, 200);
+    let v: serde_json::Value = serde_json::from_slice(&r.body).unwrap();
+    let p = &v["penumbra"];
+    assert_eq!(p["light"], 3);
+    let (umbra, penumbra) = (p["umbra_total"].as_u64().unwrap(), p["penumbra_total"].as_u64().unwrap());
+    assert!(umbra > 0 && penumbra > 0, "{p}");
+    assert_eq!(p["pixels"].as_array().unwrap().len() as u64, penumbra);
+    let c = &v["stats"]["shadow_counters"];
+    assert_eq!((c["umbra_pixels"].as_u64(), c["penumbra_pixels"].as_u64()), (Some(umbra), Some(penumbra)));
+}

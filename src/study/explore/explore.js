@@ -226,6 +226,10 @@ function drawOverlay() {
       g.stroke();
     }
   }
+  if ($("show-penumbra").checked && f.penumbra) {
+    g.fillStyle = "rgba(86, 180, 233, 0.75)";
+    for (const [x, y] of f.penumbra.pixels) g.fillRect(x * s, y * s, s, s);
+  }
   if ($("show-differs").checked) {
     g.fillStyle = "rgba(255, 140, 0, 0.9)";
     for (const [x, y] of f.differs.ties) g.fillRect(x * s, y * s, s, s);
@@ -258,7 +262,10 @@ function drawFrameSummary() {
   $("frame-summary").textContent =
     `${st.width}×${st.height}, ${st.polygons} polygons, ${st.light_samples} light sample(s); ` +
     `${f.shadows}: ${st.time_ms.total.toFixed(1)} ms; ${diff}.` +
-    (f.outlines_total > f.outlines.length ? ` Drawn: ${f.outlines.length} of ${f.outlines_total} stage polygons.` : "");
+    (f.outlines_total > f.outlines.length ? ` Drawn: ${f.outlines.length} of ${f.outlines_total} stage polygons.` : "") +
+    (f.penumbra && f.penumbra.light !== null
+      ? ` Area light ${f.penumbra.light}: ${f.penumbra.umbra_total} pixel(s) in its umbra, ${f.penumbra.penumbra_total} in its penumbra (blue, with the box ticked).`
+      : "");
   const rows = [];
   for (const [k, v] of Object.entries(st.time_ms)) rows.push({ cells: ["time", k, `${v.toFixed(2)} ms`] });
   for (const [k, v] of Object.entries(st.visibility_counters)) rows.push({ cells: ["visibility", k, `${v}`] });
@@ -607,6 +614,7 @@ function setUpControls() {
   $("play").onclick = togglePlay;
   $("show-outlines").onchange = drawOverlay;
   $("show-differs").onchange = drawOverlay;
+  $("show-penumbra").onchange = drawOverlay;
   const ov = $("overlay");
   ov.onpointerdown = (e) => { ov.setPointerCapture(e.pointerId); pointer(e); };
   ov.onpointermove = (e) => { if (e.buttons) pointer(e); };
