@@ -106,6 +106,15 @@ impl<'a> Reference<'a> {
         Answer { face: polygon.face, lit }
     }
 
+    /// The polygon seen at image point `(x, y)` and the visible point on it, if any.
+    pub fn visible(&self, x: f64, y: f64) -> Option<(usize, glam::DVec3)> {
+        let d = self.view.ray(x, y);
+        let far = self.view.far.unwrap_or(f64::INFINITY);
+        let (poly, _) = self.all.closest(self.scene, self.view.eye, d, self.view.near, far)?;
+        let polygon = &self.scene.polygons[poly as usize];
+        Some((poly as usize, self.view.point_on(&polygon.plane, x, y)))
+    }
+
     /// Whether pixel `(px, py)` is a tie (see the module's definition).
     pub fn is_tie(&self, px: u32, py: u32) -> bool {
         self.tie(px, py).is_some()
