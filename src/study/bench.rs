@@ -121,6 +121,16 @@ pub struct BenchRow {
     /// idle machine's ("best"): beside [`BenchRow::speedup`], it tells the engine's scaling
     /// from a neighbour's load when the two differ.
     pub speedup_best: Option<f64>,
+    /// With several thread counts: the frame's serial fraction, the share of the first
+    /// count's time that did not get faster with more threads, from Amdahl's law over the
+    /// two counts' medians (`T_n / T_1 = s + (1 − s)·n₁/n` for the first count n₁, solved
+    /// for `s`; clamped to [0, 1]). It predicts the speed-up at any count:
+    /// `1 / (s + (1 − s)/n)` from one thread. An inference from two counts on a quiet
+    /// machine, not a measurement of which code ran alone.
+    pub serial_fraction: Option<f64>,
+    /// The same, phase by phase (`phases`' names), with several thread counts.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub phase_serial: BTreeMap<String, f64>,
     /// Each phase the pipeline reports (`view`, `visibility`, `shadow_prepare`, `shading`,
     /// `reflections` where mirrors are seen).
     pub phases: BTreeMap<String, Spread>,
@@ -225,10 +235,22 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
             let (each, disturbance) = measure_undisturbed(scene, &opts, o, &pools, &mut progress)?;
             let peak_mb = o.heap.map(|h| (h.peak_bytes)() as f64 / (1024.0 * 1024.0));
             let (first, first_min) = (each[0].times_ms.clone(), each[0].frame.min_ms);
+            let (first_phases, first_frame) = (each[0].phases.clone(), each[0].frame.median_ms);
+            let n1 = pools[0].current_num_threads();
             for (m, pool) in each.into_iter().zip(&pools) {
                 let several = pools.len() > 1;
                 let speedup = several.then(|| paired_ratio(&first, &m.times_ms));
                 let speedup_best = several.then(|| times_faster(first_min, m.frame.min_ms));
+                let n = pool.current_num_threads();
+                let serial = serial_fraction(first_frame, m.frame.median_ms, n1, n);
+                let phase_serial = m
+                    .phases
+                    .iter()
+                    .filter_map(|(k, sp)| {
+                        let t1 = first_phases.get(k)?.median_ms;
+                        Some((k.clone(), serial_fraction(t1, sp.median_ms, n1, n)?))
+                    })
+                    .collect();
                 rows.push(BenchRow {
                     visibility: v.name().into(),
                     shadows: s.label(),
@@ -237,6 +259,8 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
                     frame: m.frame,
                     speedup,
                     speedup_best,
+                    serial_fraction: serial,
+                    phase_serial,
                     phases: m.phases,
                     peak_mb,
                     peak_rss_mb: peak_rss_mb(),
@@ -269,6 +293,18 @@ fn pools(threads: &[usize]) -> Result<Vec<rayon::ThreadPool>> {
 /// `first`, each run against the one beside it in time.
 fn paired_ratio(first: &[f64], other: &[f64]) -> f64 {
     median(first.iter().zip(other).map(|(&a, &b)| times_faster(a, b)).collect())
+}
+
+/// Amdahl's serial fraction from a time `t1` at `n1` threads and `tn` at `n` threads:
+/// `tn / t1 = (s + (1 − s)/n) / (s + (1 − s)/n1)` solved for `s`, clamped to [0, 1]; `None`
+/// for equal counts or times too small to tell.
+pub fn serial_fraction(t1: f64, tn: f64, n1: usize, n: usize) -> Option<f64> {
+    if n == n1 || t1 <= 1e-6 || tn <= 0.0 {
+        return None;
+    }
+    let (r, a, b) = (tn / t1, 1.0 / n1 as f64, 1.0 / n as f64);
+    let s = (b - r * a) / (r - r * a - 1.0 + b);
+    s.is_finite().then(|| s.clamp(0.0, 1.0))
 }
 
 /// How many times faster a frame of `b` ms ran than one of `a` ms (a zero time read as a
@@ -359,8 +395,10 @@ pub fn table(rows: &[BenchRow]) -> String {
     phases.sort_by_key(|p| (ORDER.iter().position(|o| o == p).unwrap_or(ORDER.len()), *p));
     phases.dedup();
     let short = |p: &str| match p {
+        "visibility" => "visib.".to_string(),
         "shadow_prepare" => "prepare".to_string(),
         "shadow_walk" => "walk".to_string(),
+        "reflections" => "mirrors".to_string(),
         other => other.to_string(),
     };
     let several = rows.iter().any(|r| r.speedup.is_some());
@@ -372,7 +410,7 @@ pub fn table(rows: &[BenchRow]) -> String {
     header.extend(phases.iter().map(|p| short(p)));
     header.push("peak MB".into());
     if several {
-        header.extend(["threads", "speed-up", "best"].map(String::from));
+        header.extend(["thr", "speed-up", "best", "serial"].map(String::from));
     }
     if others {
         header.push("others".into());
@@ -388,7 +426,8 @@ pub fn table(rows: &[BenchRow]) -> String {
             cells.extend(phases.iter().map(|p| r.phases.get(*p).map_or("-".into(), |s| format!("{:.1}", s.median_ms))));
             cells.push(r.peak_mb.map_or_else(|| format!("{:.0}*", r.peak_rss_mb), |m| format!("{m:.0}")));
             if several {
-                cells.extend([r.threads.to_string(), ratio(r.speedup), ratio(r.speedup_best)]);
+                let serial = r.serial_fraction.map_or("-".into(), |s| format!("{:.0}%", 100.0 * s));
+                cells.extend([r.threads.to_string(), ratio(r.speedup), ratio(r.speedup_best), serial]);
             }
             if others {
                 cells.push(r.disturbance.foreign_cores.map_or("-".into(), |c| format!("{c:.2}")));
@@ -411,9 +450,32 @@ pub fn table(rows: &[BenchRow]) -> String {
     for l in &lines {
         out += &line(l);
     }
-    out += "times in ms: the frame's median (least–greatest), each phase's median; --json has every spread\n";
+    out += "times in ms: the frame's median (least–greatest), each phase's median (visib.: the visibility stage);\n";
+    if several {
+        out += "thr: threads; speed-up and best over the first count (paired, fastest); serial: Amdahl's serial fraction\n";
+    }
+    out += "--json has every spread, each phase's serial fraction and the resident high-water mark\n";
     if rows.iter().any(|r| r.peak_mb.is_none()) {
         out += "* the process's resident high-water mark: no heap count for this row\n";
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::serial_fraction;
+
+    /// Amdahl's law read backwards: a frame that is 10% serial runs in 0.55 of its one-thread
+    /// time at two threads and 0.15625 at sixteen; the fraction comes back from either pair.
+    #[test]
+    fn the_serial_fraction_is_amdahls_law_read_backwards() {
+        let t = |s: f64, n: f64| s + (1.0 - s) / n;
+        for s in [0.0, 0.02, 0.1, 0.5, 1.0] {
+            let got = serial_fraction(100.0, 100.0 * t(s, 2.0), 1, 2).unwrap();
+            assert!((got - s).abs() < 1e-12, "{s}: {got}");
+            let got = serial_fraction(100.0 * t(s, 2.0), 100.0 * t(s, 16.0), 2, 16).unwrap();
+            assert!((got - s).abs() < 1e-12, "{s} from 2 and 16: {got}");
+        }
+        assert_eq!(serial_fraction(100.0, 100.0, 2, 2), None);
+    }
 }
