@@ -9,7 +9,7 @@ use cli::progress::TerminalBar;
 use std::alloc::{GlobalAlloc, Layout};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+use std::sync::atomic::{AtomicBool, AtomicIsize, Ordering::Relaxed};
 use std::sync::Arc;
 use umbra::shadow::Counting;
 use umbra::shadow::{
@@ -28,25 +28,68 @@ static ALLOCATOR: Counted = Counted(mimalloc::MiMalloc);
 
 /// mimalloc, with the bytes in use and their peak counted, so that `bench` can give each
 /// row its own peak memory ([`umbra::study::bench::HeapProbe`]): the resident high-water
-/// mark only rises, and mimalloc keeps what it frees ([`keep_freed_memory`]).
+/// mark only rises, and mimalloc keeps what it frees ([`keep_freed_memory`]). Each thread
+/// adds up its own allocations and frees and passes them on to the shared count once they
+/// come to a megabyte either way ([`FLUSH`]): counting every allocation in shared atomics
+/// made the threads fight over them (Atherton-Weiler-Greenberg on s4 no faster at two
+/// threads than at one). The count, and so the peak, is right to within a megabyte a thread.
+/// It runs only while `bench` asks ([`count_heap`]): for one untimed frame a row, so that the
+/// timed frames pay nothing for it.
 struct Counted(mimalloc::MiMalloc);
 
-/// Bytes allocated and not yet freed.
-static IN_USE: AtomicUsize = AtomicUsize::new(0);
-/// The most bytes in use since the last [`reset_peak`].
-static PEAK: AtomicUsize = AtomicUsize::new(0);
+/// Whether allocations are being counted.
+static COUNTING: AtomicBool = AtomicBool::new(false);
 
-fn grew(bytes: usize) {
-    let now = IN_USE.fetch_add(bytes, Relaxed) + bytes;
-    PEAK.fetch_max(now, Relaxed);
+/// Bytes allocated and not yet freed, as passed on by the threads.
+static IN_USE: AtomicIsize = AtomicIsize::new(0);
+/// The most bytes in use since the last [`reset_peak`].
+static PEAK: AtomicIsize = AtomicIsize::new(0);
+/// How far a thread's own count may run before it is passed on.
+const FLUSH: isize = 1 << 20;
+
+thread_local! {
+    /// This thread's bytes allocated less freed, not yet passed on.
+    static PENDING: std::cell::Cell<isize> = const { std::cell::Cell::new(0) };
 }
 
-fn reset_peak() {
-    PEAK.store(IN_USE.load(Relaxed), Relaxed);
+/// `bytes` allocated (positive) or freed (negative) by this thread.
+fn moved(bytes: isize) {
+    if !COUNTING.load(Relaxed) {
+        return;
+    }
+    let pass_on = PENDING
+        .try_with(|p| {
+            let v = p.get() + bytes;
+            if v.abs() >= FLUSH {
+                p.set(0);
+                v
+            } else {
+                p.set(v);
+                0
+            }
+        })
+        .unwrap_or(bytes);
+    if pass_on != 0 {
+        let now = IN_USE.fetch_add(pass_on, Relaxed) + pass_on;
+        PEAK.fetch_max(now, Relaxed);
+    }
+}
+
+fn grew(bytes: usize) {
+    moved(bytes as isize);
+}
+
+/// Starts counting from zero (`true`), or stops (`false`).
+fn count_heap(on: bool) {
+    if on {
+        IN_USE.store(0, Relaxed);
+        PEAK.store(0, Relaxed);
+    }
+    COUNTING.store(on, Relaxed);
 }
 
 fn peak_bytes() -> u64 {
-    PEAK.load(Relaxed) as u64
+    PEAK.load(Relaxed).max(0) as u64
 }
 
 // SAFETY: every call is passed on to mimalloc unchanged; only counters are updated beside.
@@ -72,15 +115,14 @@ unsafe impl GlobalAlloc for Counted {
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         // SAFETY: `ptr` came from this allocator with `layout`, as the caller promised.
         unsafe { self.0.dealloc(ptr, layout) };
-        IN_USE.fetch_sub(layout.size(), Relaxed);
+        moved(-(layout.size() as isize));
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         // SAFETY: as the caller promised for `ptr`, `layout` and `new_size`.
         let p = unsafe { self.0.realloc(ptr, layout, new_size) };
         if !p.is_null() {
-            IN_USE.fetch_sub(layout.size(), Relaxed);
-            grew(new_size);
+            moved(new_size as isize - layout.size() as isize);
         }
         p
     }
@@ -845,7 +887,7 @@ fn bench_command(a: BenchArgs) -> umbra::Result<()> {
         back_face_cull: !a.no_back_face_cull,
         undisturbed: a.undisturbed,
         threads: a.threads,
-        heap: Some(umbra::study::bench::HeapProbe { reset: reset_peak, peak_bytes }),
+        heap: Some(umbra::study::bench::HeapProbe { count: count_heap, peak_bytes }),
     };
     let rows = umbra::study::bench::bench(&scene, &opts, |what| {
         use std::io::Write;

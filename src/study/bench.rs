@@ -47,14 +47,15 @@ pub struct BenchOptions {
     pub heap: Option<HeapProbe>,
 }
 
-/// A program's count of its heap (a counting global allocator): `reset` makes the peak the
-/// bytes in use now, `peak_bytes` reads the most in use since. The `umbra` binary counts
-/// its allocator's bytes this way.
+/// A program's count of its heap (a counting global allocator). `bench` counts one frame a
+/// row, the first (a warm-up where there is one, so that the timed frames pay nothing for
+/// the count): the most bytes that frame had allocated at once, the scene (loaded before)
+/// not included. The `umbra` binary counts its allocator's bytes this way.
 #[derive(Debug, Clone, Copy)]
 pub struct HeapProbe {
-    /// Makes the peak the bytes in use now.
-    pub reset: fn(),
-    /// The most bytes in use since the last reset.
+    /// Starts counting from zero (`true`) or stops (`false`).
+    pub count: fn(bool),
+    /// The most bytes allocated at once since counting started.
     pub peak_bytes: fn() -> u64,
 }
 
@@ -134,8 +135,8 @@ pub struct BenchRow {
     /// Each phase the pipeline reports (`view`, `visibility`, `shadow_prepare`, `shading`,
     /// `reflections` where mirrors are seen).
     pub phases: BTreeMap<String, Spread>,
-    /// The row's own peak: the most heap in use while it ran, the scene's included, in MB
-    /// (`None` without a [`HeapProbe`]).
+    /// The row's own peak: the most heap its first frame had allocated at once, the scene
+    /// not included, in MB (`None` without a [`HeapProbe`]).
     pub peak_mb: Option<f64>,
     /// The process's peak resident memory after the row, in MB (0 where the system does
     /// not say): a high-water mark, so a row after a larger one shows the larger one's.
@@ -223,16 +224,17 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
     for &v in &o.visibility {
         for s in &o.shadows {
             progress(&format!("{v} + {s}"));
-            if let Some(h) = o.heap {
-                (h.reset)();
-            }
             let opts = RenderOptions {
                 visibility: v,
                 shadows: s.clone(),
                 back_face_cull: o.back_face_cull,
                 ..RenderOptions::default()
             };
-            let (each, disturbance) = measure_undisturbed(scene, &opts, o, &pools, &mut progress)?;
+            let measured = measure_undisturbed(scene, &opts, o, &pools, &mut progress);
+            if let Some(h) = o.heap {
+                (h.count)(false);
+            }
+            let (each, disturbance) = measured?;
             let peak_mb = o.heap.map(|h| (h.peak_bytes)() as f64 / (1024.0 * 1024.0));
             let (first, first_min) = (each[0].times_ms.clone(), each[0].frame.min_ms);
             let (first_phases, first_frame) = (each[0].phases.clone(), each[0].frame.median_ms);
@@ -334,6 +336,10 @@ fn measure_undisturbed(
         let mut timings: Vec<Timing> = pools.iter().map(|_| Timing::default()).collect();
         for i in 0..o.warmup + o.runs {
             let timed = i >= o.warmup;
+            // The first frame is counted (see `HeapProbe`), the rest are not.
+            if let Some(h) = o.heap.filter(|_| i <= 1) {
+                (h.count)(i == 0);
+            }
             // Where the count changes before each frame, an untimed frame first settles the
             // new count's threads, cores and caches, as a run of frames at one count would.
             let settle = usize::from(timed && pools.len() > 1);
