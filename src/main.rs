@@ -28,49 +28,24 @@ static ALLOCATOR: Counted = Counted(mimalloc::MiMalloc);
 
 /// mimalloc, with the bytes in use and their peak counted, so that `bench` can give each
 /// row its own peak memory ([`umbra::study::bench::HeapProbe`]): the resident high-water
-/// mark only rises, and mimalloc keeps what it frees ([`keep_freed_memory`]). Each thread
-/// adds up its own allocations and frees and passes them on to the shared count once they
-/// come to a megabyte either way ([`FLUSH`]): counting every allocation in shared atomics
-/// made the threads fight over them (Atherton-Weiler-Greenberg on s4 no faster at two
-/// threads than at one). The count, and so the peak, is right to within a megabyte a thread.
-/// It runs only while `bench` asks ([`count_heap`]): for one untimed frame a row, so that the
-/// timed frames pay nothing for it.
+/// mark only rises, and mimalloc keeps what it frees ([`keep_freed_memory`]). It counts only
+/// while `bench` asks ([`count_heap`]), for one untimed frame a row: counting every
+/// allocation in shared atomics makes threads fight over them (Atherton-Weiler-Greenberg
+/// on s4 ran no faster at two threads than at one), so the timed frames must not pay it.
 struct Counted(mimalloc::MiMalloc);
 
 /// Whether allocations are being counted.
 static COUNTING: AtomicBool = AtomicBool::new(false);
-
-/// Bytes allocated and not yet freed, as passed on by the threads.
+/// Bytes allocated and not yet freed since counting started (a free of older memory can
+/// take it below zero).
 static IN_USE: AtomicIsize = AtomicIsize::new(0);
-/// The most bytes in use since the last [`reset_peak`].
+/// The most bytes in use since counting started.
 static PEAK: AtomicIsize = AtomicIsize::new(0);
-/// How far a thread's own count may run before it is passed on.
-const FLUSH: isize = 1 << 20;
 
-thread_local! {
-    /// This thread's bytes allocated less freed, not yet passed on.
-    static PENDING: std::cell::Cell<isize> = const { std::cell::Cell::new(0) };
-}
-
-/// `bytes` allocated (positive) or freed (negative) by this thread.
+/// `bytes` allocated (positive) or freed (negative).
 fn moved(bytes: isize) {
-    if !COUNTING.load(Relaxed) {
-        return;
-    }
-    let pass_on = PENDING
-        .try_with(|p| {
-            let v = p.get() + bytes;
-            if v.abs() >= FLUSH {
-                p.set(0);
-                v
-            } else {
-                p.set(v);
-                0
-            }
-        })
-        .unwrap_or(bytes);
-    if pass_on != 0 {
-        let now = IN_USE.fetch_add(pass_on, Relaxed) + pass_on;
+    if COUNTING.load(Relaxed) {
+        let now = IN_USE.fetch_add(bytes, Relaxed) + bytes;
         PEAK.fetch_max(now, Relaxed);
     }
 }
