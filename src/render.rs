@@ -149,6 +149,33 @@ impl Renderer {
         Renderer::default()
     }
 
+    /// The bytes of frame-sized buffers the renderer keeps for the next frame (shadow
+    /// maps, depth and id buffers, stencil counts, lit masks, mirror frames), the last frame
+    /// itself and what stages keep of their own (the shadow volumes' adjacency) aside.
+    pub fn kept_bytes(&self) -> usize {
+        self.pools.bytes()
+    }
+
+    /// Lets go of everything kept for the next frame: the buffers of
+    /// [`Renderer::kept_bytes`] (which becomes 0) and what stages keep of their own; the
+    /// last frame and a shadow database given with `with_shadow_database` stay. After
+    /// a frame with large shadow maps, a program that renders on with something smaller
+    /// gives their memory back. The next frame allocates what it needs again.
+    ///
+    /// ```
+    /// use umbra::{generate, RenderOptions, Renderer};
+    /// let scene = generate::cubes(1, false, 64, 48)?;
+    /// let mut renderer = Renderer::new();
+    /// renderer.render(&scene, &RenderOptions { shadows: "williams".parse()?, ..Default::default() })?;
+    /// assert!(renderer.kept_bytes() > 1 << 20); // a 2048² map
+    /// renderer.trim();
+    /// assert_eq!(renderer.kept_bytes(), 0);
+    /// # Ok::<(), umbra::Error>(())
+    /// ```
+    pub fn trim(&mut self) {
+        self.pools = crate::pool::Pools::default();
+    }
+
     /// Renders `scene` with the chosen stages, into the memory of the last frame; the
     /// result lives until the next call.
     pub fn render(&mut self, scene: &Scene, opts: &RenderOptions) -> Result<&Rendered> {
@@ -200,11 +227,6 @@ impl Renderer {
     /// The last frame rendered, to keep.
     pub fn into_rendered(self) -> Option<Rendered> {
         self.last
-    }
-
-    /// Bytes of frame-sized buffers kept for the next frame (besides the last frame's).
-    pub fn kept_bytes(&self) -> usize {
-        self.pools.bytes()
     }
 }
 
