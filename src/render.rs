@@ -159,8 +159,8 @@ impl Renderer {
     /// Lets go of everything kept for the next frame: the buffers of
     /// [`Renderer::kept_bytes`] (which becomes 0) and what stages keep of their own; the
     /// last frame and a shadow database given with `with_shadow_database` stay. After
-    /// a frame with large shadow maps, a program that renders on with something smaller
-    /// gives their memory back. The next frame allocates what it needs again.
+    /// a frame with large shadow maps, a program that goes on with something smaller calls
+    /// it to give their memory back; the next frame allocates what it needs again.
     ///
     /// ```
     /// use umbra::{generate, RenderOptions, Renderer};
