@@ -10,7 +10,7 @@ fn main() -> Result<(), umbra::Error> {
     let mut renderer = umbra::Renderer::new();
     for frame in 0..100 {
         let out = renderer.render(&scene, &RenderOptions::default())?;
-        println!("{frame}: {:.1} ms", out.stats.time_ms["total"]);
+        println!("{frame}: {:.1} ms", out.stats.time_ms.total);
     }
     built()
 }

@@ -16,8 +16,8 @@ fn main() {
     for _ in 0..n {
         let t = std::time::Instant::now();
         let out = umbra::render(&scene, &opts).unwrap();
-        for (k, v) in &out.stats.time_ms {
-            phases.entry(k.to_string()).or_default().push(*v);
+        for (k, v) in out.stats.time_ms.steps().chain([("total", out.stats.time_ms.total)]) {
+            phases.entry(k.to_string()).or_default().push(v);
         }
         drop(out);
         walls.push(t.elapsed().as_secs_f64() * 1e3);

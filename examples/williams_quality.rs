@@ -56,7 +56,7 @@ fn main() {
                     let mut frame = None;
                     for _ in 0..3 {
                         let r = render(&scene, &opts).unwrap();
-                        times.push(r.stats.time_ms["total"]);
+                        times.push(r.stats.time_ms.total);
                         frame = Some(r.frame);
                     }
                     times.sort_by(f64::total_cmp);

@@ -79,5 +79,5 @@ pub use reflection::ReflectionMethod;
 pub use render::{render, RenderOptions, Rendered, Renderer};
 pub use scene::{Camera, Light, Material, Mesh, Object, Scene, SceneBuilder};
 pub use shadow::ShadowMethod;
-pub use stats::{Counters, Stats};
+pub use stats::{Counters, Stats, Times};
 pub use visibility::VisibilityMethod;

@@ -267,7 +267,7 @@ fn render_with(scene: &Scene, opts: &RenderOptions, kept: &Kept, spare: Option<F
         if crate::reflection::add_reflections(scene, opts.reflection, &mut out.frame, &runs, passes)? {
             // Blending in what the mirrors show can overflow what the frame pass kept finite.
             out.frame.color.par_chunks_mut(1 << 16).for_each(saturate);
-            out.stats.time_ms.insert("reflections", ms(t.elapsed()));
+            out.stats.time_ms.reflections = Some(ms(t.elapsed()));
         }
     }
     Ok((out, outlines))
@@ -308,12 +308,12 @@ fn frame_pass(
     };
     let screen = view.screen_polygons_in(scene, seen, pools.stash.take());
     stats.visibility_counters.add("screen_polygons", screen.len() as u64);
-    stats.time_ms.insert("view", ms(t.elapsed()));
+    stats.time_ms.view = ms(t.elapsed());
 
     let t = Instant::now();
     bar.phase(format!("visibility ({})", opts.visibility.name()));
     let (runs, pixel_counters) = visible_runs(scene, opts, &view, &screen, pools, &mut stats.visibility_counters);
-    stats.time_ms.insert("visibility", ms(t.elapsed()));
+    stats.time_ms.visibility = ms(t.elapsed());
 
     let t = Instant::now();
     bar.phase(format!("shadow preparation ({})", opts.shadows.label()));
@@ -325,7 +325,7 @@ fn frame_pass(
     if let Some(soft) = opts.soft_edges {
         shadows = Box::new(soft_edged(&ctx, shadows.as_ref(), soft)?);
     }
-    stats.time_ms.insert("shadow_prepare", ms(t.elapsed()));
+    stats.time_ms.shadow_prepare = ms(t.elapsed());
 
     let t = Instant::now();
     let (lights, background) = (scene.lights.len(), scene.render.background);
@@ -351,15 +351,15 @@ fn frame_pass(
     for (shadow, ..) in &bands {
         stats.shadow_counters.merge(shadow);
     }
-    stats.time_ms.insert("shadow_walk", pass * walk_share);
-    stats.time_ms.insert("shading", pass * (1.0 - walk_share));
+    stats.time_ms.shadow_walk = pass * walk_share;
+    stats.time_ms.shading = pass * (1.0 - walk_share);
     // Seed 000's umbra and penumbra of the area lights, counted over the visible pixels.
     if frame.light_samples.iter().any(|&n| n > 1) {
         let (umbra, penumbra) = frame.umbra_and_penumbra();
         stats.shadow_counters.add("umbra_pixels", umbra);
         stats.shadow_counters.add("penumbra_pixels", penumbra);
     }
-    stats.time_ms.insert("total", ms(start.elapsed()));
+    stats.time_ms.total = ms(start.elapsed());
     // Empty unless asked for: the stages keep outlines only then (`ShadowContext::keep_outlines`).
     let outlines = shadows.outlines();
     drop(shadows);

@@ -57,12 +57,44 @@ pub struct Stats {
     pub visibility_counters: Counters,
     /// Shadow counters.
     pub shadow_counters: Counters,
-    /// Milliseconds per step (wall clock): `view` (clipping and projection), `visibility`
-    /// (preparing the stage and resolving every line into runs), `shadow_prepare`,
-    /// `shadow_walk` (the shadow stage's per-line walk: which pixels of each run every light
-    /// sample reaches), `shading` (the shading of every run), `total`; `reflections` when a
-    /// mirror is seen. The walk and the shading run line by line in the same parallel pass;
-    /// that pass's wall-clock time is split between them in the proportion of their summed
-    /// per-band times.
-    pub time_ms: BTreeMap<&'static str, f64>,
+    /// Milliseconds per step (wall clock).
+    pub time_ms: Times,
+}
+
+/// Milliseconds per step of a render (wall clock). The walk and the shading run line by line
+/// in the same parallel pass; that pass's wall-clock time is split between them in the
+/// proportion of their summed per-band times.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct Times {
+    /// Clipping and projecting the polygons.
+    pub view: f64,
+    /// Preparing the visibility stage and resolving every line into runs.
+    pub visibility: f64,
+    /// Preparing the shadow stage.
+    pub shadow_prepare: f64,
+    /// The shadow stage's per-line walk: which pixels of each run every light sample reaches.
+    pub shadow_walk: f64,
+    /// Shading every run.
+    pub shading: f64,
+    /// Rendering what the mirrors show, when a mirror is seen.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reflections: Option<f64>,
+    /// The whole frame.
+    pub total: f64,
+}
+
+impl Times {
+    /// Each step but the total, by name, in the pipeline's order (`reflections` when there
+    /// was one).
+    pub fn steps(&self) -> impl Iterator<Item = (&'static str, f64)> {
+        let steps = [
+            ("view", Some(self.view)),
+            ("visibility", Some(self.visibility)),
+            ("shadow_prepare", Some(self.shadow_prepare)),
+            ("shadow_walk", Some(self.shadow_walk)),
+            ("shading", Some(self.shading)),
+            ("reflections", self.reflections),
+        ];
+        steps.into_iter().filter_map(|(k, v)| Some((k, v?)))
+    }
 }

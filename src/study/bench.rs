@@ -198,8 +198,8 @@ impl Timing {
         let out = self.renderer.render(scene, opts)?;
         if timed {
             self.times_ms.push(t.elapsed().as_secs_f64() * 1e3);
-            for (k, ms) in out.stats.time_ms.iter().filter(|(k, _)| **k != "total") {
-                self.phases.entry(k.to_string()).or_default().push(*ms);
+            for (k, ms) in out.stats.time_ms.steps() {
+                self.phases.entry(k.to_string()).or_default().push(ms);
             }
         }
         Ok(())
