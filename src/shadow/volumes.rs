@@ -584,9 +584,9 @@ struct Apart {
 
 /// An edge keyed by its two welded end positions (the lesser first), with the polygon on it.
 struct KeyedEdge {
+    /// The two end positions' bits, the lesser first: the edge runs from the first to the
+    /// second (the positions are the bits read back, so they are not kept twice).
     key: ([u64; 3], [u64; 3]),
-    a: DVec3,
-    b: DVec3,
     on: Sharing,
 }
 
@@ -634,9 +634,9 @@ impl Adjacency {
                     let (ka, kb) = (a.to_array().map(f64::to_bits), b.to_array().map(f64::to_bits));
                     let on = |forward| Sharing { poly: p as u32, forward };
                     keyed.push(if ka <= kb {
-                        KeyedEdge { key: (ka, kb), a, b, on: on(true) }
+                        KeyedEdge { key: (ka, kb), on: on(true) }
                     } else {
-                        KeyedEdge { key: (kb, ka), a: b, b: a, on: on(false) }
+                        KeyedEdge { key: (kb, ka), on: on(false) }
                     });
                 }
             }
@@ -668,7 +668,8 @@ impl Adjacency {
         for (i, k) in keyed.iter().enumerate() {
             if i == 0 || keyed[i - 1].key != k.key {
                 let first = self.sharing.len() as u32;
-                self.edges.push(MergedEdge { a: k.a, b: k.b, first, count: 0 });
+                let at = |bits: [u64; 3]| DVec3::from_array(bits.map(f64::from_bits));
+                self.edges.push(MergedEdge { a: at(k.key.0), b: at(k.key.1), first, count: 0 });
             }
             self.sharing.push(k.on);
             if let Some(e) = self.edges.last_mut() {
