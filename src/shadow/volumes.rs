@@ -187,15 +187,7 @@ fn shadow_polygons(
     // Step 3: the volumes kept apart, each with its own sides and caps.
     let (mut piece, mut scratch, mut proj) = (Piece::default(), Scratch::default(), Projector::default());
     for apart in adjacency.apart.iter().filter(|apart| casts(apart.poly as usize)) {
-        let owner = Some(ctx.scene.polygons[apart.poly as usize].face);
-        let v = &apart.verts;
-        for k in 0..v.len() {
-            let (a, c) = (v[k], v[(k + 1) % v.len()]);
-            piece.add(camera, &mut scratch, b.side(a, c, b.net_weight_one(a, c, apart.poly as usize), owner));
-        }
-        for cap in b.caps(&mut proj, v, apart.poly as usize, owner) {
-            piece.add(camera, &mut scratch, cap);
-        }
+        b.apart_into(apart, true, &mut piece, camera, &mut scratch, &mut proj);
     }
     pieces.push(piece);
     pieces
@@ -275,17 +267,7 @@ fn crow_1977(
         }
     }
     for apart in adjacency.apart.iter().filter(|apart| facing[apart.poly as usize]) {
-        let owner = Some(scene.polygons[apart.poly as usize].face);
-        let v = &apart.verts;
-        for k in 0..v.len() {
-            let (a, c) = (v[k], v[(k + 1) % v.len()]);
-            piece.add(camera, &mut scratch, b.side(a, c, b.net_weight_one(a, c, apart.poly as usize), owner));
-        }
-        if counting == Counting::ZFail {
-            for cap in b.caps(&mut proj, v, apart.poly as usize, owner) {
-                piece.add(camera, &mut scratch, cap);
-            }
-        }
+        b.apart_into(apart, counting == Counting::ZFail, &mut piece, camera, &mut scratch, &mut proj);
     }
     // Step 4.
     if counting == Counting::ZPass {
@@ -517,6 +499,30 @@ impl<'c> Builder<'c> {
                 [cap, None]
             }
             Counting::NaiveZPass => [None, None],
+        }
+    }
+
+    /// The volume kept apart of `apart` into `piece`, put through `camera`: a side on each
+    /// of its edges, and its caps when `caps` (`proj` is scratch for a near cap).
+    fn apart_into(
+        &self,
+        apart: &Apart,
+        caps: bool,
+        piece: &mut Piece,
+        camera: &Camera,
+        scratch: &mut Scratch,
+        proj: &mut Projector,
+    ) {
+        let (poly, v) = (apart.poly as usize, &apart.verts);
+        let owner = Some(self.ctx.scene.polygons[poly].face);
+        for k in 0..v.len() {
+            let (a, c) = (v[k], v[(k + 1) % v.len()]);
+            piece.add(camera, scratch, self.side(a, c, self.net_weight_one(a, c, poly), owner));
+        }
+        if caps {
+            for cap in self.caps(proj, v, poly, owner) {
+                piece.add(camera, scratch, cap);
+            }
         }
     }
 

@@ -447,30 +447,19 @@ impl DepthMap {
     /// texel's centre), so a wide kernel needs no slope allowance. Texels outside the map
     /// count as lit.
     fn filter_receiver_plane(&self, batch: &Located, r: usize, (a, b): (f32, f32), out: &mut [f32]) {
-        let (n, stride) = (self.size as i64, (self.size + PAD) as usize);
-        let width = 2 * r + 1;
-        let share = 1.0 / (width * width) as f32;
-        let len = out.len();
-        let (xs, ys) = (&batch.x.as_flattened()[..len], &batch.y.as_flattened()[..len]);
-        let thresholds = &batch.threshold.as_flattened()[..len];
-        for (k, o) in out.iter_mut().enumerate() {
-            let (x, y, t) = (xs[k], ys[k], thresholds[k]);
-            if !(x.is_finite() && y.is_finite()) {
-                *o = 1.0; // behind the light, or within the bias of it
-                continue;
-            }
+        let r = r as i64;
+        let share = 1.0 / ((2 * r + 1) * (2 * r + 1)) as f32;
+        Self::per_point(batch, out, |x, y, t| {
             let (cx, cy) = (x.floor() as i64, y.floor() as i64);
-            let r = r as i64;
             let mut lit = 0u32;
             for ty in cy - r..=cy + r {
                 for tx in cx - r..=cx + r {
-                    let inside = (0..n).contains(&tx) && (0..n).contains(&ty);
                     let receiver = t + a * (tx as f32 + 0.5 - x) + b * (ty as f32 + 0.5 - y);
-                    lit += u32::from(!inside || self.nearness[ty as usize * stride + tx as usize] <= receiver);
+                    lit += u32::from(self.passes(tx, ty, receiver));
                 }
             }
-            *o = lit as f32 * share;
-        }
+            lit as f32 * share
+        });
     }
 
     /// Reeves, Salesin & Cook (1987): the `(2r+1)`-texel box around each located point cut
@@ -480,18 +469,9 @@ impl DepthMap {
     /// uses the fixed box of the regular filter (ours), so the two differ only in where the
     /// samples fall.
     fn filter_stochastic(&self, batch: &Located, r: usize, out: &mut [f32]) {
-        let (n, stride) = (self.size as i64, (self.size + PAD) as usize);
         let width = 2 * r + 1;
         let share = 1.0 / (width * width) as f32;
-        let len = out.len();
-        let (xs, ys) = (&batch.x.as_flattened()[..len], &batch.y.as_flattened()[..len]);
-        let thresholds = &batch.threshold.as_flattened()[..len];
-        for (k, o) in out.iter_mut().enumerate() {
-            let (x, y, t) = (xs[k], ys[k], thresholds[k]);
-            if !(x.is_finite() && y.is_finite()) {
-                *o = 1.0; // behind the light, or within the bias of it
-                continue;
-            }
+        Self::per_point(batch, out, |x, y, t| {
             let seed = (u64::from(x.to_bits()) << 32) | u64::from(y.to_bits());
             let (x0, y0) = (x - width as f32 / 2.0, y - width as f32 / 2.0);
             let mut lit = 0u32;
@@ -500,12 +480,30 @@ impl DepthMap {
                 let (jx, jy) =
                     ((jitter >> 40) as f32 / (1u64 << 24) as f32, (jitter & 0xff_ffff) as f32 / (1u64 << 24) as f32);
                 let (sx, sy) = (x0 + (cell % width) as f32 + jx, y0 + (cell / width) as f32 + jy);
-                let (tx, ty) = (sx.floor() as i64, sy.floor() as i64);
-                let inside = (0..n).contains(&tx) && (0..n).contains(&ty);
-                lit += u32::from(!inside || self.nearness[ty as usize * stride + tx as usize] <= t);
+                lit += u32::from(self.passes(sx.floor() as i64, sy.floor() as i64, t));
             }
-            *o = lit as f32 * share;
+            lit as f32 * share
+        });
+    }
+
+    /// Each located point's answer from `answer(x, y, threshold)` into `out`; 1 for a point
+    /// with no place in the map (behind the light, or within the bias of it).
+    fn per_point(batch: &Located, out: &mut [f32], mut answer: impl FnMut(f32, f32, f32) -> f32) {
+        let len = out.len();
+        let (xs, ys) = (&batch.x.as_flattened()[..len], &batch.y.as_flattened()[..len]);
+        let thresholds = &batch.threshold.as_flattened()[..len];
+        for (k, o) in out.iter_mut().enumerate() {
+            let (x, y) = (xs[k], ys[k]);
+            *o = if x.is_finite() && y.is_finite() { answer(x, y, thresholds[k]) } else { 1.0 };
         }
+    }
+
+    /// Whether texel `(tx, ty)` lets a point of threshold `t` through: it lies outside the
+    /// map (nothing was recorded there) or holds nothing nearer than `t`.
+    fn passes(&self, tx: i64, ty: i64, t: f32) -> bool {
+        let (n, stride) = (self.size as i64, (self.size + PAD) as usize);
+        let inside = (0..n).contains(&tx) && (0..n).contains(&ty);
+        !inside || self.nearness[ty as usize * stride + tx as usize] <= t
     }
 
     /// Compares each texel of the `(2r+1)²` kernel around each located point with the
