@@ -437,6 +437,11 @@ struct RenderArgs {
     /// spacing, wider blur), from 0.25 to 64.
     #[arg(long, default_value_t = 1.0, requires = "soft_edges")]
     tap_spacing: f64,
+    /// With --soft-edges: one f32 screen buffer per light sample, all lights shaded in one
+    /// pass (per-sample, ours), or the article's one 8-bit buffer shared by every sample, a
+    /// shading pass per sample added to the frame (shared; the default with --paper).
+    #[arg(long, value_name = "BUFFERS", value_parser = parse::<umbra::shadow::Buffers>, requires = "soft_edges")]
+    soft_edge_buffers: Option<umbra::shadow::Buffers>,
 }
 
 #[derive(clap::Args)]
@@ -762,7 +767,15 @@ fn render_command(a: RenderArgs) -> umbra::Result<()> {
         reflection: a.reflection,
         outlines: a.debug.is_some(),
         back_face_cull: !a.no_back_face_cull,
-        soft_edges: a.soft_edges.map(|blur| umbra::shadow::SoftEdges { blur, spacing: a.tap_spacing }),
+        soft_edges: a.soft_edges.map(|blur| umbra::shadow::SoftEdges {
+            blur,
+            spacing: a.tap_spacing,
+            buffers: a.soft_edge_buffers.unwrap_or(if a.shadow.paper {
+                umbra::shadow::Buffers::Shared
+            } else {
+                umbra::shadow::Buffers::PerSample
+            }),
+        }),
     };
     let bar = Arc::new(TerminalBar::new("{msg:40} {bar:30} {pos}/{len} lines {elapsed}"));
     let shown = bar.clone();

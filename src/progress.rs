@@ -50,6 +50,12 @@ impl<'f> Reporter<'f> {
         }
     }
 
+    /// A phase that does the work's steps over again begins, from none done.
+    pub(crate) fn again(&self, name: impl Into<String>) {
+        self.done.store(0, Ordering::Relaxed);
+        self.phase(name);
+    }
+
     /// `n` more steps done.
     pub(crate) fn advance(&self, n: u64) {
         let Some(to) = self.to else { return };

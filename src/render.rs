@@ -62,14 +62,20 @@ impl Default for RenderOptions {
 
 impl RenderOptions {
     /// The same options with the shadow stage as its paper publishes it
-    /// ([`ShadowMethod::as_published`], the command line's `--paper`).
+    /// ([`ShadowMethod::as_published`], the command line's `--paper`), and Shastry's soft
+    /// edges, when asked for, in the article's shared buffer.
     ///
     /// ```
-    /// let paper = umbra::RenderOptions::default().as_published();
+    /// use umbra::shadow::{Buffers, SoftEdges};
+    /// let opts = umbra::RenderOptions { soft_edges: Some(SoftEdges::default()), ..Default::default() };
+    /// let paper = opts.as_published();
     /// assert!(paper.shadows.is_paper());
+    /// assert_eq!(paper.soft_edges.unwrap().buffers, Buffers::Shared);
     /// ```
     pub fn as_published(&self) -> RenderOptions {
-        RenderOptions { shadows: self.shadows.as_published(), ..self.clone() }
+        let soft_edges =
+            self.soft_edges.map(|s| crate::shadow::SoftEdges { buffers: crate::shadow::Buffers::Shared, ..s });
+        RenderOptions { shadows: self.shadows.as_published(), soft_edges, ..self.clone() }
     }
 }
 
@@ -322,7 +328,10 @@ fn frame_pass(
         .with_awg_database(kept.awg_database.clone());
     stats.light_samples = ctx.samples.iter().map(Vec::len).sum();
     let mut shadows = opts.shadows.prepare(&ctx, &mut stats.shadow_counters)?;
-    if let Some(soft) = opts.soft_edges {
+    // Shastry's soft edges: ours, a blurred buffer per sample served in place of the
+    // stage; the article's shared buffer, a shading pass per sample (below).
+    let shared = opts.soft_edges.filter(|s| s.buffers == crate::shadow::Buffers::Shared);
+    if let Some(soft) = opts.soft_edges.filter(|_| shared.is_none()) {
         shadows = Box::new(soft_edged(&ctx, shadows.as_ref(), soft)?);
     }
     stats.time_ms.shadow_prepare = ms(t.elapsed());
@@ -341,8 +350,13 @@ fn frame_pass(
     };
     frame.light_samples = ctx.samples.iter().map(|s| s.len() as u32).collect();
     frame.counters = pixel_counters;
-    bar.phase("shadow walk and shading");
-    let bands = shade_frame(&ctx, &*shadows, &mut frame, &bar);
+    let bands = match shared {
+        Some(soft) => shade_shared(&ctx, &*shadows, soft, &mut frame, &bar)?,
+        None => {
+            bar.phase("shadow walk and shading");
+            shade_frame(&ctx, &*shadows, &mut frame, &bar)
+        }
+    };
     // The bands ran on several threads: the wall-clock time of the pass is split between
     // the shadow walk and the shading in the proportion of their summed band times.
     let pass = ms(t.elapsed());
@@ -504,8 +518,8 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
     (shadow, walking, shading)
 }
 
-/// Shastry's soft edges on `stage`: its answers walked into a screen buffer per light
-/// sample (step 1 of [`crate::shadow::soft_edges`]), in parallel bands, then blurred.
+/// Shastry's soft edges on `stage`, ours: every light sample's term walked into a screen
+/// buffer of its own (step 1 of [`crate::shadow::soft_edges`]), then blurred.
 fn soft_edged(
     ctx: &ShadowContext,
     stage: &dyn crate::shadow::ShadowStage,
@@ -517,6 +531,60 @@ fn soft_edged(
     // The terms and their blurred copies, and one pass's scratch.
     let bytes = crate::budget::mul(crate::budget::mul(samples as u64 + 1, w as u64 * h as u64), 8);
     crate::budget::check(format_args!("soft edges: {samples} screen buffer(s) of {w}x{h}"), bytes)?;
+    let terms = shadow_terms(ctx, stage, 0..samples);
+    let first = (0..ctx.samples.len()).map(|l| ctx.sample_index(l, 0)).collect();
+    Ok(crate::shadow::soft_edges::SoftEdged::new(terms, w, h as usize, first, soft))
+}
+
+/// Shastry's soft edges as the article keeps them: one 8-bit screen buffer shared by every
+/// light sample. An ambient pass, then per sample: its term walked into the buffer, blurred,
+/// and a shading pass lit by it alone, added to the frame (as the article's passes are
+/// blended). Returns every pass's band work.
+fn shade_shared(
+    ctx: &ShadowContext,
+    stage: &dyn crate::shadow::ShadowStage,
+    soft: crate::shadow::SoftEdges,
+    frame: &mut Frame,
+    bar: &Reporter,
+) -> Result<Vec<BandWork>> {
+    use crate::shadow::soft_edges::SoftEdged;
+    soft.check()?;
+    let (w, h) = (ctx.view.width as usize, ctx.view.height as usize);
+    let samples: usize = ctx.samples.iter().map(Vec::len).sum();
+    // The ambient frame and the sum of the passes (colour), and one pass's term and blur.
+    let bytes = crate::budget::mul(w as u64 * h as u64, 2 * 12 + 4 * 4);
+    crate::budget::check(format_args!("soft edges: a shared screen buffer of {w}x{h}"), bytes)?;
+    let first: Vec<usize> = (0..ctx.samples.len()).map(|l| ctx.sample_index(l, 0)).collect();
+    bar.again("soft edges, shared buffer: the ambient pass");
+    let mut bands = shade_frame(ctx, &SoftEdged::shared(None, w, first.clone()), frame, bar);
+    let ambient = frame.color.clone();
+    let mut color = ambient.clone();
+    let mut light = frame.light.clone();
+    for k in 0..samples {
+        bar.again(format!("soft edges, shared buffer: sample {} of {samples}", k + 1));
+        let term = shadow_terms(ctx, stage, k..k + 1).pop().unwrap_or_default();
+        let pass = SoftEdged::shared(Some((k, soft.blurred_8bit(&term, w, h))), w, first.clone());
+        bands.extend(shade_frame(ctx, &pass, frame, bar));
+        color.par_iter_mut().zip(&frame.color).zip(&ambient).for_each(|((sum, &c), &a)| *sum += c - a);
+        for (sum, pass) in light.iter_mut().zip(&frame.light) {
+            sum.par_iter_mut().zip(pass).for_each(|(s, &v)| *s += v);
+        }
+    }
+    frame.color = color;
+    frame.light = light;
+    Ok(bands)
+}
+
+/// Step 1 of [`crate::shadow::soft_edges`]: the lit fraction of the flat light samples in
+/// `keep` at every pixel, one `w×h` buffer each (1 where nothing is seen), walked in
+/// parallel bands.
+fn shadow_terms(
+    ctx: &ShadowContext,
+    stage: &dyn crate::shadow::ShadowStage,
+    keep: std::ops::Range<usize>,
+) -> Vec<Vec<f32>> {
+    let (w, h) = (ctx.view.width as usize, ctx.view.height);
+    let samples: usize = ctx.samples.iter().map(Vec::len).sum();
     let band = crate::scan::band_height(h);
     let bands: Vec<Vec<f32>> = (0..h.div_ceil(band))
         .into_par_iter()
@@ -525,16 +593,16 @@ fn soft_edged(
             let mut walker = stage.walker();
             let mut lit = vec![0.0f32; samples * w];
             // Sample-major rows of this band: `out[k][(y - y0) * w + x]`, 1 where nothing is seen.
-            let mut out = vec![1.0f32; samples * (y1 - y0) as usize * w];
             let per_sample = (y1 - y0) as usize * w;
+            let mut out = vec![1.0f32; keep.len() * per_sample];
             for y in y0..y1 {
                 walker.start_line(y);
                 let runs = &ctx.runs.lines[y as usize];
                 walk_line(ctx, walker.as_mut(), y, runs, &mut lit, |_, _, _, _, _, _| {});
                 for run in runs {
-                    for k in 0..samples {
+                    for (i, k) in keep.clone().enumerate() {
                         let (a, b) = (run.x0 as usize, run.x1 as usize);
-                        let at = k * per_sample + (y - y0) as usize * w;
+                        let at = i * per_sample + (y - y0) as usize * w;
                         out[at + a..at + b].copy_from_slice(&lit[k * w + a..k * w + b]);
                     }
                 }
@@ -542,15 +610,14 @@ fn soft_edged(
             out
         })
         .collect();
-    let mut terms = vec![Vec::with_capacity(w * h as usize); samples];
+    let mut terms = vec![Vec::with_capacity(w * h as usize); keep.len()];
     for (b, out) in bands.iter().enumerate() {
         let rows = (((b as u32 + 1) * band).min(h) - b as u32 * band) as usize;
-        for (k, term) in terms.iter_mut().enumerate() {
-            term.extend_from_slice(&out[k * rows * w..(k + 1) * rows * w]);
+        for (i, term) in terms.iter_mut().enumerate() {
+            term.extend_from_slice(&out[i * rows * w..(i + 1) * rows * w]);
         }
     }
-    let first = (0..ctx.samples.len()).map(|l| ctx.sample_index(l, 0)).collect();
-    Ok(crate::shadow::soft_edges::SoftEdged::new(terms, w, h as usize, first, soft))
+    terms
 }
 
 /// Background pixels: no polygon, no light.

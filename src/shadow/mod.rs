@@ -26,7 +26,7 @@ use crow::Crow;
 use planar::Planar;
 pub(crate) use ray_cast::blocked;
 use ray_cast::RayCastShadows;
-pub use soft_edges::{Blur, SoftEdges};
+pub use soft_edges::{Blur, Buffers, SoftEdges};
 
 /// A light's projection target for [`crate::reference::exact_fraction`]: the plane and the
 /// rectangle `rect` of it, seen from the point `from` (projection from a point, as from a

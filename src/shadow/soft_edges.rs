@@ -13,9 +13,12 @@
 //!    texel of the buffer; `spacing` multiplies them (rounded to whole pixels).
 //! 4. **Read back** when shading, in place of the stage's own answer.
 //!
-//! The article shares one screen buffer among all lights, reusing it light by light; here
-//! every light sample keeps its own, since all lights are shaded in one pass (memory is
-//! checked against the budget before any is made).
+//! **The buffers.** The article keeps one 8-bit screen buffer (and the blur's render
+//! targets) for all lights: it renders one light's term into it, blurs it, shades that
+//! light's pass and adds the pass to the frame, then reuses the buffer for the next light
+//! ([`Buffers::Shared`]). Ours, the default ([`Buffers::PerSample`]): every light sample keeps
+//! its own buffer, in f32, so that all lights are shaded in one pass (8 bytes a pixel per
+//! sample, checked against the budget before any is made).
 
 use super::{Decision, Detail, ShadowWalker};
 use crate::error::Result;
@@ -49,18 +52,47 @@ impl Blur {
 
 crate::error::named!(Blur, "blur");
 
-/// Shastry's soft edges: which blur, and how far apart its taps are.
+/// Where the screen buffers of soft edges are kept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[non_exhaustive]
+pub enum Buffers {
+    /// Ours: one f32 buffer per light sample, all lights shaded in one pass.
+    #[default]
+    PerSample,
+    /// The article's: one 8-bit screen buffer shared by every light sample, a shading pass
+    /// per sample added to the frame.
+    Shared,
+}
+
+impl Buffers {
+    /// Every choice.
+    pub const ALL: [Buffers; 2] = [Buffers::PerSample, Buffers::Shared];
+
+    /// The choice's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Buffers::PerSample => "per-sample",
+            Buffers::Shared => "shared",
+        }
+    }
+}
+
+crate::error::named!(Buffers, "soft-edge buffers");
+
+/// Shastry's soft edges: which blur, how far apart its taps are, where its buffers are kept.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SoftEdges {
     /// The blur.
     pub blur: Blur,
     /// The taps' spacing in pixels (the article's: 1). Larger spacing, wider blur.
     pub spacing: f64,
+    /// The screen buffers: one per light sample (ours) or one shared (the article's).
+    pub buffers: Buffers,
 }
 
 impl Default for SoftEdges {
     fn default() -> Self {
-        SoftEdges { blur: Blur::Gaussian, spacing: 1.0 }
+        SoftEdges { blur: Blur::Gaussian, spacing: 1.0, buffers: Buffers::PerSample }
     }
 }
 
@@ -92,6 +124,14 @@ impl SoftEdges {
             }
         };
         out.into_iter().map(|v| v.clamp(0.0, 1.0)).collect()
+    }
+
+    /// Steps 1 to 3 as the article's 8-bit render targets hold them: `term` quantised to
+    /// 1/255, blurred, quantised again.
+    pub(crate) fn blurred_8bit(&self, term: &[f32], w: usize, h: usize) -> Vec<u8> {
+        let to_8bit = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+        let screen: Vec<f32> = term.iter().map(|&v| f32::from(to_8bit(v)) / 255.0).collect();
+        self.blurred(&screen, w, h).into_iter().map(to_8bit).collect()
     }
 
     /// An offset of `o` texels at this spacing, in whole pixels.
@@ -179,10 +219,18 @@ fn disk(src: &[f32], w: usize, h: usize, taps: &[(i64, i64)]) -> Vec<f32> {
 /// A stage whose answers are read from blurred screen buffers (step 4).
 pub(crate) struct SoftEdged {
     width: usize,
-    /// `blurred[flat sample index][pixel]`.
-    blurred: Vec<Vec<f32>>,
+    held: Held,
     /// The flat index of each light's first sample.
     first: Vec<usize>,
+}
+
+/// What the buffers hold.
+enum Held {
+    /// Ours: `blurred[flat sample index][pixel]`.
+    PerSample(Vec<Vec<f32>>),
+    /// The article's shared 8-bit buffer, holding one sample's blurred term (every other
+    /// sample reads 0: its pass is not this one); `None`: the ambient pass, all read 0.
+    Shared(Option<(usize, Vec<u8>)>),
 }
 
 impl SoftEdged {
@@ -190,7 +238,13 @@ impl SoftEdged {
     /// by `options`. `first[l]`: the flat index of light `l`'s first sample.
     pub(crate) fn new(terms: Vec<Vec<f32>>, w: usize, h: usize, first: Vec<usize>, options: SoftEdges) -> Self {
         let blurred = terms.iter().map(|t| options.blurred(t, w, h)).collect();
-        SoftEdged { width: w, blurred, first }
+        SoftEdged { width: w, held: Held::PerSample(blurred), first }
+    }
+
+    /// The stage of one pass over the article's shared buffer: flat sample `k`'s blurred
+    /// term (from [`SoftEdges::blurred_8bit`]), or with `None` the ambient pass.
+    pub(crate) fn shared(pass: Option<(usize, Vec<u8>)>, w: usize, first: Vec<usize>) -> Self {
+        SoftEdged { width: w, held: Held::Shared(pass), first }
     }
 }
 
@@ -208,7 +262,16 @@ impl ShadowWalker for Reader<'_> {
     fn lit(&mut self, light: usize, sample: usize, line: u32, run: &Run, lit: &mut [f32]) {
         let k = self.stage.first[light] + sample;
         let row = line as usize * self.stage.width;
-        lit.copy_from_slice(&self.stage.blurred[k][row + run.x0 as usize..row + run.x1 as usize]);
+        let pixels = row + run.x0 as usize..row + run.x1 as usize;
+        match &self.stage.held {
+            Held::PerSample(blurred) => lit.copy_from_slice(&blurred[k][pixels]),
+            Held::Shared(Some((pass, buffer))) if *pass == k => {
+                for (l, &v) in lit.iter_mut().zip(&buffer[pixels]) {
+                    *l = f32::from(v) / 255.0;
+                }
+            }
+            Held::Shared(_) => lit.fill(0.0),
+        }
     }
 
     fn decision(&self) -> Decision {
@@ -228,13 +291,13 @@ mod tests {
         let term: Vec<f32> = (0..w * h).map(|i| if i % w < 32 { 0.0 } else { 1.0 }).collect();
         for blur in Blur::ALL {
             let ramp = |spacing| {
-                let out = SoftEdges { blur, spacing }.blurred(&term, w, h);
+                let out = SoftEdges { blur, spacing, ..Default::default() }.blurred(&term, w, h);
                 assert!(out.iter().all(|v| (0.0..=1.0).contains(v)));
                 out[4 * w..5 * w].iter().filter(|&&v| v > 0.02 && v < 0.98).count()
             };
             let (narrow, wide) = (ramp(1.0), ramp(2.0));
             assert!(narrow >= 4 && wide > narrow, "{blur:?}: ramps of {narrow} and {wide} pixels");
-            let flat = SoftEdges { blur, spacing: 1.0 }.blurred(&vec![1.0; w * h], w, h);
+            let flat = SoftEdges { blur, ..Default::default() }.blurred(&vec![1.0; w * h], w, h);
             assert!(flat.iter().all(|&v| v == 1.0), "{blur:?}");
         }
     }

@@ -266,6 +266,38 @@ fn stochastic_percentage_closer_filter() {
 /// Shastry's soft edges run on any stage: on Crow's exact volumes they soften the shadow
 /// edges (values strictly between 0 and 1 appear, all within [0, 1]); and Williams'
 /// `soft-edge` filter is the same thing as its PCF term with the soft edges applied.
+/// The article's one 8-bit screen buffer shared by every light sample, a shading pass per
+/// sample added to the frame, gives what a buffer per sample gives, but for the 8-bit
+/// quantisation of the blurred term (half a grey level) and the order of the sums: every
+/// light kind, both blurs.
+#[test]
+fn soft_edges_in_the_shared_buffer_equal_a_buffer_per_sample_to_eight_bits() {
+    use umbra::shadow::{Blur, Buffers, SoftEdges};
+    let scene = load_scaled(&"scenes/lights.toml".into(), 120);
+    let crow: ShadowMethod = "crow".parse().unwrap();
+    for blur in Blur::ALL {
+        let render = |buffers| {
+            let soft_edges = Some(SoftEdges { blur, buffers, ..Default::default() });
+            umbra::render(&scene, &RenderOptions { shadows: crow.clone(), soft_edges, ..Default::default() })
+                .unwrap()
+                .frame
+        };
+        let (ours, article) = (render(Buffers::PerSample), render(Buffers::Shared));
+        assert_eq!(ours.id, article.id);
+        let mut soft = 0;
+        for (l, (a, b)) in ours.light.iter().zip(&article.light).enumerate() {
+            for (&x, &y) in a.iter().zip(b) {
+                assert!((x - y).abs() <= 0.5 / 255.0 + 1e-6, "{blur:?}, light {l}: {x} against {y}");
+                soft += usize::from(y > 0.0 && y < 1.0);
+            }
+        }
+        assert!(soft > 100, "{blur:?}: {soft} soft pixels");
+        let (a, b) = (ours.color_image(None), article.color_image(None));
+        let worst = a.as_raw().iter().zip(b.as_raw()).map(|(&x, &y)| x.abs_diff(y)).max().unwrap();
+        assert!(worst <= 2, "{blur:?}: colours differ by {worst} grey levels");
+    }
+}
+
 #[test]
 fn soft_edges_soften_any_stage_and_equal_williams_soft_edge_filter() {
     use umbra::shadow::{Blur, SoftEdges};
@@ -277,7 +309,7 @@ fn soft_edges_soften_any_stage_and_equal_williams_soft_edge_filter() {
     let crow: ShadowMethod = "crow".parse().unwrap();
     let exact = render(crow.clone(), None);
     for blur in [Blur::Gaussian, Blur::Poisson] {
-        let soft = render(crow.clone(), Some(SoftEdges { blur, spacing: 1.0 }));
+        let soft = render(crow.clone(), Some(SoftEdges { blur, ..Default::default() }));
         let l = &soft.light[0];
         assert!(l.iter().all(|v| (0.0..=1.0).contains(v)), "{blur:?}");
         let between = l.iter().filter(|&&v| v > 0.0 && v < 1.0).count();
