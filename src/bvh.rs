@@ -124,6 +124,50 @@ impl Bvh {
         }
     }
 
+    /// Calls `f` with every item in a leaf whose box meets the box `lo..hi` (a superset of
+    /// the items whose own boxes meet it).
+    pub(crate) fn overlapping(&self, lo: DVec3, hi: DVec3, mut f: impl FnMut(u32)) {
+        let mut stack = if self.nodes.is_empty() { Vec::new() } else { vec![0u32] };
+        while let Some(n) = stack.pop() {
+            let node = self.nodes[n as usize];
+            if node.lo.cmpgt(hi).any() || node.hi.cmplt(lo).any() {
+                continue;
+            }
+            if node.count == 0 {
+                stack.extend([node.first, node.first + 1]);
+            } else {
+                self.items[node.first as usize..(node.first + node.count) as usize].iter().for_each(|&i| f(i));
+            }
+        }
+    }
+
+    /// Calls `f` with every item in a leaf whose box is not wholly outside one of `planes`
+    /// (`(n, d)`: outside where `n·x > d`).
+    pub(crate) fn within(&self, planes: &[(DVec3, f64)], mut f: impl FnMut(u32)) {
+        let mut stack = if self.nodes.is_empty() { Vec::new() } else { vec![0u32] };
+        while let Some(n) = stack.pop() {
+            let node = self.nodes[n as usize];
+            // The box's corner least far along each plane's normal.
+            let outside = planes.iter().any(|&(n, d)| {
+                let near = DVec3::select(n.cmpge(DVec3::ZERO), node.lo, node.hi);
+                n.dot(near) > d
+            });
+            if outside {
+                continue;
+            }
+            if node.count == 0 {
+                stack.extend([node.first, node.first + 1]);
+            } else {
+                self.items[node.first as usize..(node.first + node.count) as usize].iter().for_each(|&i| f(i));
+            }
+        }
+    }
+
+    /// Calls `f` with every item.
+    pub(crate) fn each(&self, f: impl FnMut(u32)) {
+        self.items.iter().copied().for_each(f);
+    }
+
     /// The nearest polygon hit by `o + t d` with `t in [tmin, tmax]`, and its `t`.
     pub fn closest(&self, scene: &Scene, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<(u32, f64)> {
         let mut best: Option<(u32, f64)> = None;

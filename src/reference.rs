@@ -115,6 +115,19 @@ impl<'a> Reference<'a> {
         Some((poly as usize, self.view.point_on(&polygon.plane, x, y)))
     }
 
+    /// [`exact_fraction`] of area light `light` at the point seen at image point `(x, y)`,
+    /// with the casters found through the BVH (those whose boxes meet the box around the
+    /// point and the light); `None` on background, for a light that is not an area light,
+    /// or where a clip fails.
+    pub fn exact_fraction_at(&self, light: usize, x: f64, y: f64) -> Option<f64> {
+        let (poly, p) = self.visible(x, y)?;
+        let area = crate::shadow::AreaLight::of(self.scene, light)?;
+        let (lo, hi) = area.vertices().iter().fold((p, p), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+        let mut near = Vec::new();
+        self.casters.overlapping(lo, hi, |i| near.push(i as usize));
+        fraction_among(self.scene, &self.view, light, p, poly, near.into_iter())
+    }
+
     /// Whether pixel `(px, py)` is a tie (see the module's definition).
     pub fn is_tie(&self, px: u32, py: u32) -> bool {
         self.tie(px, py).is_some()
@@ -188,44 +201,41 @@ impl<'a> Reference<'a> {
 /// # Ok::<(), umbra::Error>(())
 /// ```
 pub fn exact_fraction(scene: &Scene, light: usize, p: glam::DVec3, poly: usize) -> Option<f64> {
+    let casters = (0..scene.polygons.len()).filter(|&i| scene.casts_shadows(i));
+    fraction_among(scene, &View::new(&scene.camera), light, p, poly, casters)
+}
+
+/// [`exact_fraction`] with the casters among `casters` (a superset of those that can cross
+/// a segment from `p` to the light).
+fn fraction_among(
+    scene: &Scene,
+    view: &View,
+    light: usize,
+    p: glam::DVec3,
+    poly: usize,
+    casters: impl Iterator<Item = usize>,
+) -> Option<f64> {
     use crate::geometry::weiler_atherton::{clip, Region};
-    use crate::scene::LightKind;
-    use glam::{DVec2, DVec3};
-    let LightKind::Area { corner, edge_u, edge_v, .. } = scene.lights.get(light)?.kind else { return None };
+    let area = crate::shadow::AreaLight::of(scene, light)?;
     let polygon = scene.polygons.get(poly)?;
-    let eye = View::new(&scene.camera).eye;
-    // The light's own coordinates: Q = corner + a·u + b·v, and back.
-    let normal = edge_u.cross(edge_v);
-    let to_ab = |q: DVec3| {
-        let d = q - corner;
-        let (uu, uv, vv) = (edge_u.dot(edge_u), edge_u.dot(edge_v), edge_v.dot(edge_v));
-        let (du, dv) = (d.dot(edge_u), d.dot(edge_v));
-        let det = uu * vv - uv * uv;
-        DVec2::new((du * vv - dv * uv) / det, (dv * uu - du * uv) / det)
-    };
-    // Step 1: the unit square cut by the plane of `poly`, to the side the eye sees.
-    let seen = polygon.plane.distance(eye).signum();
-    let side = |ab: DVec2| seen * polygon.plane.distance(corner + edge_u * ab.x + edge_v * ab.y);
-    let square = vec![DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
-    let mut lit = Vec::new();
-    crate::geometry::clip_polygon(&square, side, &mut lit);
-    if lit.len() < 3 || seen == 0.0 {
+    let seen = polygon.plane.distance(view.eye).signum();
+    if seen == 0.0 {
         return Some(0.0);
     }
-    let mut region = Region::from_ring(lit);
+    // Step 1: the unit square cut by the plane of `poly`, to the side the eye sees.
+    let square = Region::from_ring(vec![glam::DVec2::ZERO, glam::DVec2::X, glam::DVec2::ONE, glam::DVec2::Y]);
+    let mut cut = Vec::new();
+    area.cut_away(&polygon.plane, seen, &mut cut);
+    let mut region = if cut.is_empty() { square } else { clip(&square, &Region::from_ring(cut)).ok()?.outside };
     // Step 2: each other face's casting polygons' shadows from P on the light, subtracted.
-    let rect = [corner, corner + edge_u, corner + edge_u + edge_v, corner + edge_v];
-    let plane = crate::geometry::Plane::new(normal.normalize(), corner);
-    let target = crate::shadow::projection_target(plane, rect, p);
+    let target = area.target_from(p);
     let mut proj = crate::shadow::Projector::default();
-    for (i, g) in scene.polygons.iter().enumerate() {
-        if g.face == polygon.face || !scene.casts_shadows(i) || !proj.project(scene.verts(i), &target) {
-            continue;
-        }
-        let shadow = Region::from_ring(proj.shadow.iter().map(|&q| to_ab(q)).collect());
-        region = clip(&region, &shadow).ok()?.outside;
+    for i in casters.filter(|&i| scene.polygons[i].face != polygon.face) {
         if region.rings.is_empty() {
             return Some(0.0);
+        }
+        if proj.project(scene.verts(i), &target) {
+            region = clip(&region, &Region::from_ring(area.shadow_ab(&proj))).ok()?.outside;
         }
     }
     Some(region.area().abs().min(1.0))

@@ -349,6 +349,14 @@ fn frame_pass(
         None => Frame::new(view.width, view.height, lights, background),
     };
     frame.light_samples = ctx.samples.iter().map(|s| s.len() as u32).collect();
+    // A stage that answers for a whole light gives its exact fraction (`Frame::light_samples`).
+    let probe = shadows.walker();
+    for (l, n) in frame.light_samples.iter_mut().enumerate() {
+        if probe.whole_light(l) {
+            *n = 0;
+        }
+    }
+    drop(probe);
     frame.counters = pixel_counters;
     let bands = match shared {
         Some(soft) => shade_shared(&ctx, &*shadows, soft, &mut frame, &bar)?,
@@ -368,7 +376,7 @@ fn frame_pass(
     stats.time_ms.shadow_walk = pass * walk_share;
     stats.time_ms.shading = pass * (1.0 - walk_share);
     // Seed 000's umbra and penumbra of the area lights, counted over the visible pixels.
-    if frame.light_samples.iter().any(|&n| n > 1) {
+    if (0..frame.light.len()).any(|k| frame.is_area(k)) {
         let (umbra, penumbra) = frame.umbra_and_penumbra();
         stats.shadow_counters.add("umbra_pixels", umbra);
         stats.shadow_counters.add("penumbra_pixels", penumbra);
@@ -647,7 +655,19 @@ pub(crate) fn walk_line(
     for run in runs {
         let plane = &ctx.scene.polygons[run.poly as usize].plane;
         for (k, (l, s, sample)) in ctx.all_samples().enumerate() {
-            let out = &mut lit[k * width + run.x0 as usize..k * width + run.x1 as usize];
+            let row = k * width + run.x0 as usize..k * width + run.x1 as usize;
+            if walker.whole_light(l) {
+                // The stage answers for the whole light: sample 0's row holds the answer,
+                // copied to the others'.
+                if s == 0 {
+                    walker.lit(l, 0, y, run, &mut lit[row.clone()]);
+                    after(run, l, 0, true, walker, &lit[row]);
+                } else {
+                    lit.copy_within(row.start - s * width..row.end - s * width, row.start);
+                }
+                continue;
+            }
+            let out = &mut lit[row];
             let asked = sample.on_seen_side(plane, ctx.view.eye);
             if asked {
                 walker.lit(l, s, y, run, out);

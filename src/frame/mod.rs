@@ -35,7 +35,9 @@ pub struct Frame {
     pub id: Vec<u32>,
     /// `light[k][pixel]`: lit fraction of light `k` at the visible point (0 on background).
     pub light: Vec<Vec<f32>>,
-    /// Samples of each light (the lit fraction of an exact stage is a multiple of 1/n).
+    /// Samples of each light (the lit fraction of an exact stage is a multiple of 1/n); 0
+    /// where the stage gave an area light's exact fraction (`nishita-nakamae`), any number
+    /// from 0 to 1.
     pub light_samples: Vec<u32>,
     /// Per-pixel counters, when the render was asked for them.
     pub counters: Option<PixelCounters>,
@@ -153,12 +155,12 @@ impl Frame {
     /// so a half is a half however the fraction was summed.
     /// `None` when the frame has no light `k`.
     pub fn light_image(&self, k: usize) -> Option<image::GrayImage> {
-        let n = self.light_samples.get(k).copied().unwrap_or(1).max(1) as f64;
+        let n = self.light_samples.get(k).copied().unwrap_or(1) as f64;
         let light = self.light.get(k)?;
         Some(image::GrayImage::from_fn(self.width, self.height, |x, y| {
             let f = light[(y * self.width + x) as usize] as f64;
             let m = (f * n).round();
-            let exact = if (f * n - m).abs() < 1e-4 { 255.0 * m / n } else { 255.0 * f };
+            let exact = if n > 0.0 && (f * n - m).abs() < 1e-4 { 255.0 * m / n } else { 255.0 * f };
             image::Luma([exact.round().clamp(0.0, 255.0) as u8])
         }))
     }
@@ -167,14 +169,15 @@ impl Frame {
     /// `docs/scene-format.md` §6): `None` on background, else umbra (no sample lights the
     /// visible point), penumbra (some do) or lit (all do). A sample counts as lighting the
     /// point by its share of the lit fraction, so a fraction within half a sample's share of
-    /// 0 is umbra and within half a share of 1 is lit (the stages' sums of `1/n` round).
+    /// 0 is umbra and within half a share of 1 is lit (the stages' sums of `1/n` round). An
+    /// exact fraction (`light_samples[k] == 0`) is umbra at 0 and lit at 1.
     pub fn shade_class(&self, k: usize, i: usize) -> Option<ShadeClass> {
         if self.id.get(i).is_none_or(|&id| id == BACKGROUND) {
             return None;
         }
-        let n = self.light_samples.get(k).copied().unwrap_or(1).max(1) as f32;
+        let n = self.light_samples.get(k).copied().unwrap_or(1);
         let f = *self.light.get(k)?.get(i)?;
-        let half = 0.5 / n;
+        let half = if n == 0 { 0.0 } else { 0.5 / n as f32 };
         Some(if f <= half {
             ShadeClass::Umbra
         } else if f >= 1.0 - half {
@@ -184,12 +187,17 @@ impl Frame {
         })
     }
 
+    /// Whether light `k` is an area light: of more than one sample, or given its exact
+    /// fraction.
+    pub fn is_area(&self, k: usize) -> bool {
+        self.light_samples.get(k).is_some_and(|&n| n != 1)
+    }
+
     /// The visible pixels in the umbra and in the penumbra of the area lights (more than
     /// one sample), summed over them.
     pub(crate) fn umbra_and_penumbra(&self) -> (u64, u64) {
         use rayon::prelude::*;
-        let areas: Vec<usize> =
-            (0..self.light.len()).filter(|&k| self.light_samples.get(k).is_some_and(|&n| n > 1)).collect();
+        let areas: Vec<usize> = (0..self.light.len()).filter(|&k| self.is_area(k)).collect();
         (0..self.id.len())
             .into_par_iter()
             .map(|i| {
@@ -202,11 +210,11 @@ impl Frame {
             .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
     }
 
-    /// `umbra<k>.png` for an area light `k` (more than one sample): 8-bit grey, 0 umbra, 128
+    /// `umbra<k>.png` for an area light `k` ([`Frame::is_area`]): 8-bit grey, 0 umbra, 128
     /// penumbra, 255 lit, and 0 on background (which `id.png` tells apart); `None` for a
     /// light of one sample, which has no penumbra, or no light `k`.
     pub fn umbra_image(&self, k: usize) -> Option<image::GrayImage> {
-        if self.light_samples.get(k).copied().unwrap_or(1) <= 1 || k >= self.light.len() {
+        if !self.is_area(k) || k >= self.light.len() {
             return None;
         }
         Some(image::GrayImage::from_fn(self.width, self.height, |x, y| {

@@ -10,6 +10,7 @@
 mod atherton_weiler_greenberg;
 mod bouknight_kelley;
 mod crow;
+mod nishita_nakamae;
 mod overlay;
 mod planar;
 mod projection;
@@ -23,6 +24,8 @@ use atherton_weiler_greenberg::AthertonWeilerGreenberg;
 pub use atherton_weiler_greenberg::{DetailPolygon, ShadowDatabase};
 use bouknight_kelley::BouknightKelley;
 use crow::Crow;
+pub(crate) use nishita_nakamae::AreaLight;
+use nishita_nakamae::NishitaNakamae;
 use planar::Planar;
 pub(crate) use ray_cast::blocked;
 use ray_cast::RayCastShadows;
@@ -335,6 +338,13 @@ pub(crate) trait ShadowWalker {
     /// called for runs whose polygon faces the sample on its seen side.
     fn lit(&mut self, light: usize, sample: usize, line: u32, run: &Run, lit: &mut [f32]);
 
+    /// Whether the stage answers for light `light` as a whole (an area light's exact
+    /// fraction): [`ShadowWalker::lit`] is then asked for its sample 0 only, whichever side of
+    /// the run's plane the samples lie, and its answer stands for every sample.
+    fn whole_light(&self, _light: usize) -> bool {
+        false
+    }
+
     /// Adds the walker's counters.
     fn finish(&mut self, _counters: &mut Counters) {}
 
@@ -519,6 +529,9 @@ pub enum ShadowMethod {
     StencilVolume(VolumeOptions),
     /// Blinn's shadows projected onto marked receiver planes (approximate).
     Planar,
+    /// Nishita & Nakamae's umbra and penumbra polygons from the light's corners, the
+    /// penumbra's pixels by clipping the light: area lights' exact fraction.
+    NishitaNakamae,
 }
 
 impl ShadowMethod {
@@ -527,7 +540,7 @@ impl ShadowMethod {
     pub const DEFAULT: ShadowMethod = ShadowMethod::BouknightKelley(BouknightKelleyOptions::DEFAULT);
 
     /// Every method, with its default settings.
-    pub const ALL: [ShadowMethod; 8] = [
+    pub const ALL: [ShadowMethod; 9] = [
         ShadowMethod::None,
         ShadowMethod::BouknightKelley(BouknightKelleyOptions::DEFAULT),
         ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions::DEFAULT),
@@ -535,6 +548,7 @@ impl ShadowMethod {
         ShadowMethod::Williams(WilliamsOptions::DEFAULT),
         ShadowMethod::StencilVolume(VolumeOptions::DEFAULT),
         ShadowMethod::Planar,
+        ShadowMethod::NishitaNakamae,
         ShadowMethod::RayCast,
     ];
 
@@ -549,6 +563,7 @@ impl ShadowMethod {
             ShadowMethod::Williams(_) => "williams",
             ShadowMethod::StencilVolume(_) => "stencil-volume",
             ShadowMethod::Planar => "planar",
+            ShadowMethod::NishitaNakamae => "nishita-nakamae",
         }
     }
 
@@ -671,7 +686,10 @@ impl ShadowMethod {
                     && v.construction != Construction::Crow1977
                     && (v.sight_cuts || v.counting != volumes::Counting::ZFail)
             }
-            ShadowMethod::RayCast | ShadowMethod::BouknightKelley(_) | ShadowMethod::AthertonWeilerGreenberg(_) => true,
+            ShadowMethod::RayCast
+            | ShadowMethod::BouknightKelley(_)
+            | ShadowMethod::AthertonWeilerGreenberg(_)
+            | ShadowMethod::NishitaNakamae => true,
         }
     }
 
@@ -690,6 +708,7 @@ impl ShadowMethod {
             ShadowMethod::Williams(o) => Box::new(Williams::new(ctx, o, counters)?),
             ShadowMethod::StencilVolume(o) => Box::new(StencilVolume::new(ctx, *o, counters)?),
             ShadowMethod::Planar => Box::new(Planar::new(ctx, counters)?),
+            ShadowMethod::NishitaNakamae => Box::new(NishitaNakamae::new(ctx, counters)),
         })
     }
 }

@@ -105,6 +105,20 @@ pub struct Report {
 /// diff image). The diff shows the reference in grey, wrong interior pixels in red and
 /// differing edge pixels (not counted) in yellow.
 pub fn diff(reference: &Frame, got: &Frame) -> (usize, usize, image::RgbImage) {
+    diff_within(reference, got, 0)
+}
+
+/// [`diff`], with lit fractions that differ by at most `grey_levels` once written as 8-bit
+/// grey (`round(255 f)`) counted as equal: the exact area-light fraction, computed two ways,
+/// is equal to one grey level.
+pub fn diff_within(reference: &Frame, got: &Frame, grey_levels: u8) -> (usize, usize, image::RgbImage) {
+    let apart = |a: f32, b: f32| {
+        if grey_levels == 0 {
+            a != b
+        } else {
+            ((a * 255.0).round() - (b * 255.0).round()).abs() > grey_levels as f32
+        }
+    };
     let grey = reference.color_image(None);
     let mut img = image::RgbImage::new(reference.width, reference.height);
     let (mut interior, mut wrong) = (0, 0);
@@ -112,7 +126,7 @@ pub fn diff(reference: &Frame, got: &Frame) -> (usize, usize, image::RgbImage) {
         for x in 0..reference.width {
             let k = (y * reference.width + x) as usize;
             let differs =
-                reference.id[k] != got.id[k] || reference.light.iter().zip(&got.light).any(|(a, b)| a[k] != b[k]);
+                reference.id[k] != got.id[k] || reference.light.iter().zip(&got.light).any(|(a, b)| apart(a[k], b[k]));
             let g = grey.get_pixel(x, y).0.iter().map(|&c| c as u32).sum::<u32>() / 6;
             let px = if reference.is_interior(x, y) {
                 interior += 1;
@@ -155,6 +169,10 @@ pub fn compare(
     };
     let reference = render(scene, &reference_opts)?.frame;
     let reference_image = save(reference.color_image(None), "reference.png")?;
+    // Nishita & Nakamae's stage gives area lights their exact fraction, not the grid's: it is
+    // judged against the reference with the exact fractions in place (to a grey level).
+    let exact = std::cell::OnceCell::new();
+    let exact_reference = || exact.get_or_init(|| with_exact_area_fractions(scene, &reference));
     let total = (opts.visibility.len() * opts.shadows.len() * opts.runs.max(1)) as u64;
     let bar = crate::progress::Reporter::new(Some(&progress), total, "renders");
     let mut results = Vec::new();
@@ -172,7 +190,11 @@ pub fn compare(
             results.push(match measured {
                 None => MethodResult::not_run(v, s, status),
                 Some(m) => {
-                    let mut r = MethodResult::measured(v, s, status, &m, &reference, |img, file| save(img, file))?;
+                    let judge = match s {
+                        ShadowMethod::NishitaNakamae if has_area_light(scene) => (exact_reference(), 1),
+                        _ => (&reference, 0),
+                    };
+                    let mut r = MethodResult::measured(v, s, status, &m, judge, |img, file| save(img, file))?;
                     r.map_errors = super::map_errors::measure(scene, &ropts, &m.last.frame, &reference)?;
                     r
                 }
@@ -195,6 +217,33 @@ pub fn compare(
     };
     write_files(&report, &opts.out)?;
     Ok(report)
+}
+
+/// Whether `scene` has an area light.
+fn has_area_light(scene: &Scene) -> bool {
+    scene.lights.iter().any(|l| matches!(l.kind, crate::scene::LightKind::Area { .. }))
+}
+
+/// The ray-cast `reference` with each area light's lit fractions replaced by the exact ones
+/// (`docs/scene-format.md` §3, [`crate::reference::exact_fraction`]), pixel by pixel in
+/// parallel.
+fn with_exact_area_fractions(scene: &Scene, reference: &Frame) -> Frame {
+    use rayon::prelude::*;
+    let oracle = crate::reference::Reference::new(scene);
+    let mut out = reference.clone();
+    let w = reference.width as usize;
+    for (l, light) in out.light.iter_mut().enumerate() {
+        if !matches!(scene.lights[l].kind, crate::scene::LightKind::Area { .. }) {
+            continue;
+        }
+        light.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (x, f) in row.iter_mut().enumerate() {
+                let at = oracle.exact_fraction_at(l, x as f64 + 0.5, y as f64 + 0.5);
+                *f = at.map_or(*f, |v| v as f32);
+            }
+        });
+    }
+    out
 }
 
 impl MethodResult {
@@ -225,12 +274,12 @@ impl MethodResult {
         s: &ShadowMethod,
         status: String,
         m: &Measured,
-        reference: &Frame,
+        (reference, grey_levels): (&Frame, u8),
         save: impl Fn(image::RgbImage, &str) -> Result<String>,
     ) -> Result<MethodResult> {
         let id = format!("{v}-{s}{}", if s.is_paper() { "-paper" } else { "" });
         let run = &m.last;
-        let (interior, wrong, diff_img) = diff(reference, &run.frame);
+        let (interior, wrong, diff_img) = diff_within(reference, &run.frame, grey_levels);
         let counters = run
             .stats
             .visibility_counters

@@ -296,7 +296,7 @@ fn summary(scene: &Scene, r: &Request, got: &Rendered, reference: &Rendered, out
     let outlines: Vec<Vec<[f64; 2]>> =
         outlines.iter().take(MAX_OUTLINES).map(|ring| ring.iter().map(|p| p.to_array()).collect()).collect();
     // Seed 000's penumbra of the first area light (its umbra shows dark in the frame).
-    let area = (0..f.light.len()).find(|&k| f.light_samples.get(k).is_some_and(|&n| n > 1));
+    let area = (0..f.light.len()).find(|&k| f.is_area(k));
     let (mut penumbra, mut umbra_total, mut penumbra_total) = (Vec::new(), 0usize, 0usize);
     for (i, k) in area.into_iter().flat_map(|k| (0..f.id.len()).map(move |i| (i, k))) {
         match f.shade_class(k, i) {

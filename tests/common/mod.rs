@@ -149,8 +149,15 @@ pub fn assert_ids_agree(scene: &Scene, reference: &Frame, got: &Frame, label: &s
 /// Asserts that `got` has the same face id and lit fraction of every light as `reference`
 /// at every pixel but ties.
 pub fn assert_light_agree(scene: &Scene, reference: &Frame, got: &Frame, label: &str) -> Agreement {
+    assert_lights_agree(scene, reference, got, label, &(0..reference.light.len()).collect::<Vec<_>>())
+}
+
+/// [`assert_light_agree`] on the lights `lights` only.
+pub fn assert_lights_agree(scene: &Scene, reference: &Frame, got: &Frame, label: &str, lights: &[usize]) -> Agreement {
     assert_agree(scene, reference, label, "x, y, light, want, got", |x, y, k| {
-        (0..reference.light.len())
+        lights
+            .iter()
+            .copied()
             .filter(|&l| reference.id[k] != got.id[k] || reference.light[l][k] != got.light[l][k])
             .map(|l| (x, y, l, reference.light[l][k], got.light[l][k]))
             .collect()
@@ -163,4 +170,49 @@ pub fn shadowed(reference: &Frame) -> usize {
     (0..reference.id.len())
         .filter(|&k| reference.id[k] != u32::MAX && reference.light.iter().any(|l| l[k] < 1.0))
         .count()
+}
+
+/// Asserts that `got`'s lit fraction of every area light is the exact fraction
+/// (`umbra::reference::exact_fraction`) within one grey level: `round(255 f)` one apart at
+/// most, at every pixel whose seen face is the reference's at the centre and 1e-6 of a pixel
+/// around it (elsewhere the pixel is an edge tie). Returns the pixels compared and, of them,
+/// those in the exact penumbra.
+pub fn assert_area_exact(scene: &Scene, got: &Frame, label: &str) -> (usize, usize) {
+    let oracle = Reference::new(scene);
+    let areas: Vec<usize> = (0..scene.lights().len())
+        .filter(|&l| matches!(scene.lights()[l].kind, umbra::scene::LightKind::Area { .. }))
+        .collect();
+    let (mut compared, mut penumbra, mut bad) = (0, 0, Vec::new());
+    let t = umbra::reference::TIE_DELTA;
+    for y in 0..got.height {
+        for x in 0..got.width {
+            let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
+            let Some((poly, _)) = oracle.visible(cx, cy) else { continue };
+            let face = scene.polygons()[poly].face;
+            let around = [(-t, -t), (t, -t), (-t, t), (t, t), (0.0, t), (0.0, -t), (t, 0.0), (-t, 0.0)];
+            let edge = around
+                .iter()
+                .any(|&(dx, dy)| oracle.visible(cx + dx, cy + dy).map(|(q, _)| scene.polygons()[q].face) != Some(face));
+            let k = (y * got.width + x) as usize;
+            if edge || got.id[k] != face {
+                continue;
+            }
+            for &l in &areas {
+                let Some(want) = oracle.exact_fraction_at(l, cx, cy) else { continue };
+                compared += 1;
+                penumbra += usize::from(want > 1e-9 && want < 1.0 - 1e-9);
+                let (a, b) = ((want * 255.0).round(), (got.light[l][k] as f64 * 255.0).round());
+                if (a - b).abs() > 1.0 {
+                    bad.push((x, y, l, want, got.light[l][k]));
+                }
+            }
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "{label}: {} of {compared} area-light pixels off by more than a grey level (x, y, light, exact, got): {:?}",
+        bad.len(),
+        &bad[..bad.len().min(10)]
+    );
+    (compared, penumbra)
 }

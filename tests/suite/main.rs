@@ -7,6 +7,7 @@
 mod common;
 
 mod approximate;
+mod area;
 mod cli;
 mod explore;
 mod fuzz;

@@ -35,6 +35,10 @@ const INTRO = {
     "of Crow's count, rasterised before the frame is shaded.",
   "planar":
     "Blinn (1988): shadows projected onto marked receiver planes. Approximate.",
+  "nishita-nakamae":
+    "Nishita & Nakamae (1983-85): umbra and penumbra polygons from the light's corners; pixels " +
+    "in an umbra are dark and outside every penumbra lit, a span at a time; only in the penumbra " +
+    "is the visible part of an area light clipped out and measured: its exact lit fraction.",
 };
 
 const state = {

@@ -1,0 +1,85 @@
+//! Nishita & Nakamae's stage: area lights' exact lit fraction (`umbra::reference`'s
+//! `exact_fraction`, within one grey level) and every other light's ray-cast answer, behind
+//! both visibility stages, on the example scenes and random scenes.
+
+use crate::common;
+
+use common::*;
+use umbra::generate::{random, RandomOptions};
+use umbra::scene::LightKind;
+use umbra::{Scene, ShadowMethod, VisibilityMethod};
+
+const NN: ShadowMethod = ShadowMethod::NishitaNakamae;
+
+/// The lights of `scene` that are not area lights.
+fn point_lights(scene: &Scene) -> Vec<usize> {
+    (0..scene.lights().len()).filter(|&l| !matches!(scene.lights()[l].kind, LightKind::Area { .. })).collect()
+}
+
+/// Checks the stage on `scene`; returns the area-light pixels compared and those in the penumbra.
+fn check(scene: &Scene, label: &str) -> (usize, usize) {
+    let want = frame(scene, VisibilityMethod::RayCast, ShadowMethod::RayCast);
+    let mut area = (0, 0);
+    for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
+        let got = frame(scene, v, NN);
+        assert_lights_agree(scene, &want, &got, &format!("{label} behind {v}"), &point_lights(scene));
+        area = assert_area_exact(scene, &got, &format!("{label} behind {v}"));
+    }
+    area
+}
+
+#[test]
+fn the_exact_fraction_on_the_example_scenes() {
+    let mut penumbra = 0;
+    for path in scene_files() {
+        let scene = load_scaled(&path, 160);
+        penumbra += check(&scene, &path.display().to_string()).1;
+    }
+    assert!(penumbra > 500, "{penumbra} penumbra pixels compared");
+}
+
+#[test]
+fn the_exact_fraction_on_random_scenes() {
+    let (mut compared, mut penumbra) = (0, 0);
+    for seed in 0..60 {
+        let scene = random(seed, RandomOptions { width: 64, height: 48, ..RandomOptions::default() }).unwrap();
+        let (c, p) = check(&scene, &format!("random scene {seed}"));
+        compared += c;
+        penumbra += p;
+    }
+    assert!(compared > 10_000 && penumbra > 1000, "{compared} area-light pixels, {penumbra} in the penumbra");
+}
+
+/// The robustness and repro scenes (solids, interpenetrating and coplanar polygons, lights
+/// among the polygons, the area-light scenes that once found wrong pixels in other stages),
+/// but for those of more than [`LARGE`] polygons.
+#[test]
+fn the_exact_fraction_on_the_repro_scenes() {
+    assert!(repro_scenes(false) > 1000);
+}
+
+/// The repro scenes of more than [`LARGE`] polygons: the open bunny and a torus under three
+/// area lights, each wider than the scene, take tens of seconds a frame.
+#[test]
+#[ignore = "a minute: the large repro scenes; run with --ignored"]
+fn the_exact_fraction_on_the_large_repro_scenes() {
+    assert!(repro_scenes(true) > 100);
+}
+
+/// Polygons above which a repro scene is left to the ignored test.
+const LARGE: usize = 20_000;
+
+/// Checks the repro scenes of more (`large`) or at most [`LARGE`] polygons; returns the
+/// penumbra pixels compared.
+fn repro_scenes(large: bool) -> usize {
+    let mut penumbra = 0;
+    for folder in ["robustness", "solids", "awg-area"] {
+        for path in toml_files(&format!("tests/data/{folder}"), 5) {
+            let scene = load_scaled(&path, 96);
+            if (scene.polygons().len() > LARGE) == large {
+                penumbra += check(&scene, &path.display().to_string()).1;
+            }
+        }
+    }
+    penumbra
+}
