@@ -114,29 +114,84 @@ impl AreaLight {
     /// part of the light cut away by the plane, and the projection from `p` of each of
     /// `occluders` onto the light, gathered in `hidden`; the fraction is what they leave of
     /// the light ([`unhidden`]).
-    fn visible_fraction<'v>(
+    fn visible_fraction(
         &self,
         p: DVec3,
         plane: &Plane,
         seen: f64,
-        occluders: impl IntoIterator<Item = &'v [DVec3]>,
+        occluders: impl IntoIterator<Item = u32>,
+        (scene, bodies): (&Scene, &[bool]),
         scratch: &mut Scratch,
     ) -> f64 {
         scratch.hidden.clear();
+        scratch.bodies.clear();
         let mut cut = Vec::new();
         self.cut_away(plane, seen, &mut cut);
         if !cut.is_empty() {
             scratch.hidden.push(cut);
         }
         let target = self.target_from(p);
-        for verts in occluders {
-            if scratch.proj.project(verts, &target) {
-                scratch.hidden.push(self.shadow_ab(&scratch.proj));
+        for a in occluders {
+            if !scratch.proj.project(scene.verts(a as usize), &target) {
+                continue;
             }
+            let shadow = self.shadow_ab(&scratch.proj);
+            // A convex solid's polygons hide together what the solid hides: the hull of
+            // their shadows' corners (see `body_shadows`).
+            match bodies.get(scene.solid_of[a as usize] as usize) {
+                Some(true) => body_shadows(&mut scratch.bodies, scene.solid_of[a as usize], shadow),
+                _ => scratch.hidden.push(shadow),
+            }
+        }
+        scratch.body_hulls += scratch.bodies.len() as u64;
+        for (_, corners) in scratch.bodies.iter_mut() {
+            let mut hull = Vec::new();
+            convex_hull(corners, &mut hull);
+            scratch.hidden.push(hull);
         }
         scratch.clips += scratch.hidden.len() as u64;
         unhidden(&scratch.hidden, &mut scratch.sweep)
     }
+}
+
+/// Adds `shadow`'s corners to solid `solid`'s in `bodies`. Ours: for a convex closed solid
+/// apart from the light, the shadows from P of its polygons whose penumbra holds P cover,
+/// within the light, what the whole solid's shadow covers (the others hide no part of the
+/// light from P, or lie behind polygons of the solid that do), and the solid's shadow is
+/// convex and holds every such corner: so the hull of the corners is the solid's shadow
+/// within the light, one convex part where there were hundreds of polygons.
+fn body_shadows(bodies: &mut Vec<(u32, Vec<DVec2>)>, solid: u32, shadow: Vec<DVec2>) {
+    match bodies.iter_mut().find(|(s, _)| *s == solid) {
+        Some((_, corners)) => corners.extend(shadow),
+        None => bodies.push((solid, shadow)),
+    }
+}
+
+/// `convex[s]`: whether solid `s` of `scene` is convex (every vertex of it on or behind the
+/// plane of each of its polygons, to a relative 1e-9 of the scene's size), found in parallel.
+fn convex_solids(scene: &Scene, extent: f64) -> Vec<bool> {
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); scene.solids.len()];
+    for (i, &s) in scene.solid_of.iter().enumerate() {
+        if let Some(m) = members.get_mut(s as usize) {
+            m.push(i);
+        }
+    }
+    members
+        .par_iter()
+        .zip(&scene.solids)
+        .map(|(polys, solid)| {
+            // Each corner once (a vertex is shared by several polygons).
+            let mut verts: Vec<[u64; 3]> =
+                polys.iter().flat_map(|&i| scene.verts(i).iter().map(|v| v.to_array().map(f64::to_bits))).collect();
+            verts.sort_unstable();
+            verts.dedup();
+            let verts: Vec<DVec3> = verts.into_iter().map(|v| DVec3::from_array(v.map(f64::from_bits))).collect();
+            polys.iter().all(|&i| {
+                let plane = &scene.polygons[i].plane;
+                verts.iter().all(|&v| solid.sign * plane.distance(v) <= 1e-9 * extent)
+            })
+        })
+        .collect()
 }
 
 /// A walker's scratch for step 5.
@@ -144,6 +199,9 @@ impl AreaLight {
 struct Scratch {
     proj: Projector,
     hidden: Vec<Vec<DVec2>>,
+    /// Convex solids' shadow corners, by solid, and how many hulls were made of them.
+    bodies: Vec<(u32, Vec<DVec2>)>,
+    body_hulls: u64,
     sweep: Sweep,
     clips: u64,
 }
@@ -316,6 +374,8 @@ struct LightShadows {
     /// For receivers where step 5 must look beyond the penumbra polygons: the casters it
     /// takes at every pixel, and whether the light is cut by the receiver's plane.
     everywhere: FxHashMap<u32, (Vec<u32>, bool)>,
+    /// `bodies[s]`: whether solid `s` is convex and closed from all of the light.
+    bodies: Vec<bool>,
 }
 
 /// One receiver's polygons, gathered in parallel.
@@ -335,6 +395,7 @@ impl<'a> NishitaNakamae<'a> {
         let n = scene.polygons.len() as u32;
         let casters = Bvh::new(scene, (0..n).filter(|&i| scene.casts_shadows(i as usize)).collect());
         let receivers: Vec<u32> = (0..n).filter(|&i| ctx.visible[i as usize]).collect();
+        let convex = convex_solids(scene, ctx.extent);
         let lights = (0..scene.lights.len())
             .map(|l| {
                 let source = match AreaLight::of(scene, l) {
@@ -350,7 +411,8 @@ impl<'a> NishitaNakamae<'a> {
                     .par_iter()
                     .map(|&b| (b, on_receiver(ctx, &casters, &source, sample, &closed, b)))
                     .collect();
-                gather(ctx, source, per, counters)
+                let bodies = closed.iter().zip(&convex).map(|(&c, &v)| c && v).collect();
+                gather(ctx, source, per, bodies, counters)
             })
             .collect();
         counters.add("receivers", receivers.len() as u64 * scene.lights.len() as u64);
@@ -359,7 +421,13 @@ impl<'a> NishitaNakamae<'a> {
 }
 
 /// Every receiver's polygons into one light's overlays.
-fn gather(ctx: &ShadowContext, source: Source, per: Vec<(u32, OnReceiver)>, counters: &mut Counters) -> LightShadows {
+fn gather(
+    ctx: &ShadowContext,
+    source: Source,
+    per: Vec<(u32, OnReceiver)>,
+    bodies: Vec<bool>,
+    counters: &mut Counters,
+) -> LightShadows {
     let height = ctx.view.height;
     let (mut umbras, mut penumbras, mut occluder, mut dark) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut everywhere = FxHashMap::default();
@@ -386,7 +454,7 @@ fn gather(ctx: &ShadowContext, source: Source, per: Vec<(u32, OnReceiver)>, coun
     counters.add("umbra_polygons", umbra.len() as u64);
     counters.add("penumbra_polygons", penumbra.len() as u64);
     counters.add("receivers_searched_everywhere", everywhere.len() as u64);
-    LightShadows { source, umbra, penumbra, occluder, everywhere }
+    LightShadows { source, umbra, penumbra, occluder, everywhere, bodies }
 }
 
 /// Steps 1 to 3 on receiver `b`.
@@ -763,6 +831,14 @@ impl ShadowWalker for Walker<'_> {
         let plane = scene.polygons[run.poly as usize].plane;
         let seen = plane.distance(view.eye).signum();
         let before = self.tally.penumbra;
+        // What the receiver's plane leaves of the light, the same at every point of it.
+        let unobstructed = if cut {
+            let mut part = Vec::new();
+            area.cut_away(&plane, seen, &mut part);
+            unhidden(&[part], &mut self.scratch.sweep) as f32
+        } else {
+            1.0
+        };
         // The penumbra intervals come ordered by their starts: those over pixel x are kept
         // in `active` as x moves along the run.
         let (mut active, mut next) = (std::mem::take(&mut self.active), 0);
@@ -786,14 +862,17 @@ impl ShadowWalker for Walker<'_> {
                 self.tally.dark += 1;
                 continue;
             }
-            if active.is_empty() && always.is_empty() && !cut {
+            if active.is_empty() && always.is_empty() {
+                // No occluder: all of the light on the seen side of the plane reaches it.
                 self.tally.lit += 1;
+                lit[i] = unobstructed;
                 continue;
             }
             self.tally.penumbra += 1;
             let p = view.point_on(&plane, x as f64 + 0.5, line as f64 + 0.5);
-            let verts = always.iter().chain(&active).map(|&a| scene.verts(a as usize));
-            lit[i] = area.visible_fraction(p, &plane, seen, verts, &mut self.scratch) as f32;
+            let occluders = always.iter().chain(&active).copied();
+            let bodies = (scene, &shadows.bodies[..]);
+            lit[i] = area.visible_fraction(p, &plane, seen, occluders, bodies, &mut self.scratch) as f32;
         }
         self.ends.clear();
         self.active = active;
@@ -815,5 +894,6 @@ impl ShadowWalker for Walker<'_> {
         counters.add("lit_pixels_at_once", self.tally.lit);
         counters.add("penumbra_pixels_clipped", self.tally.penumbra);
         counters.add("light_parts_hidden", self.scratch.clips);
+        counters.add("convex_solid_shadows", self.scratch.body_hulls);
     }
 }

@@ -83,3 +83,46 @@ fn repro_scenes(large: bool) -> usize {
     }
     penumbra
 }
+
+/// Convex closed solids (a sphere of 400 triangles, boxes) and an open sheet under a square
+/// light: the convex solids' polygons are measured as one shadow each (the counter shows it),
+/// and the fraction is still exact, behind both visibility stages.
+#[test]
+fn convex_solids_hide_as_one() {
+    use glam::DVec3;
+    use umbra::{Camera, Light, Material, Mesh, Object};
+    let floor = Mesh::quad([
+        DVec3::new(-4.0, 0.0, -4.0),
+        DVec3::new(-4.0, 0.0, 4.0),
+        DVec3::new(4.0, 0.0, 4.0),
+        DVec3::new(4.0, 0.0, -4.0),
+    ]);
+    let light = Light::area(DVec3::new(-1.0, 4.0, -1.0), DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.0, 0.2, 2.0), [4, 4]);
+    let mut camera = Camera::new(DVec3::new(0.5, 5.0, 7.0), DVec3::ZERO);
+    (camera.width, camera.height) = (160, 120);
+    let scene = Scene::builder(camera)
+        .material(Material::new("m"))
+        .light(light)
+        .object(Object::new(floor), "m")
+        .object(Object::new(Mesh::sphere(DVec3::new(0.3, 1.2, 0.2), 0.8, 400)), "m")
+        .object(Object::new(Mesh::cuboid(DVec3::new(-2.0, 0.0, -1.5), DVec3::new(-1.2, 1.5, -0.7))), "m")
+        .object(
+            Object::new(Mesh::grid(
+                DVec3::new(1.0, 0.6, 1.0),
+                DVec3::new(0.8, 0.3, 0.0),
+                DVec3::new(0.0, 0.2, 0.8),
+                4,
+                4,
+            )),
+            "m",
+        )
+        .build()
+        .unwrap();
+    for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
+        let opts = umbra::RenderOptions { visibility: v, shadows: NN, ..Default::default() };
+        let r = umbra::render(&scene, &opts).unwrap();
+        assert!(r.stats.shadow_counters.get("convex_solid_shadows") > 100, "{:?}", r.stats.shadow_counters);
+        let (compared, penumbra) = assert_area_exact(&scene, &r.frame, &format!("convex solids behind {v}"));
+        assert!(compared > 10_000 && penumbra > 500, "{compared} compared, {penumbra} in the penumbra");
+    }
+}
