@@ -859,6 +859,12 @@ fn compare_command(a: CompareArgs) -> umbra::Result<()> {
                 "by cause:", c.acne, c.detached, c.aliasing, c.resolution
             );
         }
+        if let Some(e) = r.area_error {
+            table += &format!(
+                "{:>46} mean {:.4}, largest {:.3} over {} pixels\n",
+                "area lights against the exact fraction:", e.mean, e.max, e.pixels
+            );
+        }
     }
     stdout(&table)?;
     say(&format!("wrote {}", a.out.join("report.html").display()))

@@ -74,12 +74,50 @@ pub struct MethodResult {
     /// A shadow map's wrong interior pixels by cause ([`super::map_errors`]); `None` for
     /// other methods.
     pub map_errors: Option<super::map_errors::MapErrors>,
+    /// On a scene with area lights: how far the stage's lit fractions of the area lights are
+    /// from the exact fraction (`docs/scene-format.md` §3), over the visible pixels in the
+    /// exact penumbra where it sees the reference's face. `None` without area lights.
+    pub area_error: Option<AreaError>,
     /// The image, relative to the report.
     pub image: String,
     /// The diff image, relative to the report.
     pub diff: String,
     /// Visibility and shadow counters of the median run.
     pub counters: BTreeMap<String, u64>,
+}
+
+/// How far a stage's area-light fractions are from the exact ones.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AreaError {
+    /// Pixels in the exact penumbra compared, summed over the area lights.
+    pub pixels: usize,
+    /// The mean of `|fraction − exact|`.
+    pub mean: f64,
+    /// The largest.
+    pub max: f64,
+}
+
+impl AreaError {
+    /// `got`'s area-light fractions against `exact`'s (the reference with exact fractions).
+    fn of(scene: &Scene, exact: &Frame, got: &Frame) -> AreaError {
+        let (mut pixels, mut sum, mut max) = (0, 0.0f64, 0.0f64);
+        for (l, light) in scene.lights.iter().enumerate() {
+            if !matches!(light.kind, crate::scene::LightKind::Area { .. }) {
+                continue;
+            }
+            for k in 0..exact.id.len() {
+                let f = exact.light[l][k];
+                if exact.id[k] == crate::frame::BACKGROUND || exact.id[k] != got.id[k] || f <= 0.0 || f >= 1.0 {
+                    continue;
+                }
+                let e = (got.light[l][k] as f64 - exact.light[l][k] as f64).abs();
+                pixels += 1;
+                sum += e;
+                max = max.max(e);
+            }
+        }
+        AreaError { pixels, mean: sum / pixels.max(1) as f64, max }
+    }
 }
 
 /// The whole comparison.
@@ -170,7 +208,8 @@ pub fn compare(
     let reference = render(scene, &reference_opts)?.frame;
     let reference_image = save(reference.color_image(None), "reference.png")?;
     // Nishita & Nakamae's stage gives area lights their exact fraction, not the grid's: it is
-    // judged against the reference with the exact fractions in place (to a grey level).
+    // judged against the reference with the exact fractions in place (to a grey level). Every
+    // stage's area-light error is measured against those fractions too.
     let exact = std::cell::OnceCell::new();
     let exact_reference = || exact.get_or_init(|| with_exact_area_fractions(scene, &reference));
     let total = (opts.visibility.len() * opts.shadows.len() * opts.runs.max(1)) as u64;
@@ -196,6 +235,9 @@ pub fn compare(
                     };
                     let mut r = MethodResult::measured(v, s, status, &m, judge, |img, file| save(img, file))?;
                     r.map_errors = super::map_errors::measure(scene, &ropts, &m.last.frame, &reference)?;
+                    if has_area_light(scene) {
+                        r.area_error = Some(AreaError::of(scene, exact_reference(), &m.last.frame));
+                    }
                     r
                 }
             });
@@ -261,6 +303,7 @@ impl MethodResult {
             wrong_pixels: 0,
             error_share: 0.0,
             map_errors: None,
+            area_error: None,
             image: String::new(),
             diff: String::new(),
             counters: BTreeMap::new(),
@@ -299,6 +342,7 @@ impl MethodResult {
             wrong_pixels: wrong,
             error_share: wrong as f64 / interior.max(1) as f64,
             map_errors: None,
+            area_error: None,
             image: save(run.frame.color_image(None), &format!("{id}.png"))?,
             diff: save(diff_img, &format!("{id}-diff.png"))?,
             counters,
@@ -314,12 +358,12 @@ fn write_files(report: &Report, out: &Path) -> Result<()> {
     let json = serde_json::to_string_pretty(report).map_err(|e| Error::Internal(e.to_string()))?;
     write(&out.join("results.json"), &json)?;
     let mut csv = String::from(
-        "visibility,shadows,status,exact,median_ms,min_ms,max_ms,interior_pixels,wrong_pixels,error_share\n",
+        "visibility,shadows,status,exact,median_ms,min_ms,max_ms,interior_pixels,wrong_pixels,error_share,area_mean_error,area_max_error\n",
     );
     for r in &report.results {
         let _ = writeln!(
             csv,
-            "{},{},\"{}\",{},{:.3},{:.3},{:.3},{},{},{:.6}",
+            "{},{},\"{}\",{},{:.3},{:.3},{:.3},{},{},{:.6},{},{}",
             r.visibility,
             r.shadows,
             r.status.replace('"', "'"),
@@ -329,7 +373,9 @@ fn write_files(report: &Report, out: &Path) -> Result<()> {
             r.time.max_ms,
             r.interior_pixels,
             r.wrong_pixels,
-            r.error_share
+            r.error_share,
+            r.area_error.map_or(String::new(), |a| format!("{:.6}", a.mean)),
+            r.area_error.map_or(String::new(), |a| format!("{:.6}", a.max))
         );
     }
     write(&out.join("results.csv"), &csv)?;
@@ -566,6 +612,7 @@ fn results_table(report: &Report, out: &Path, h: &mut String) {
         "wrong / interior",
         "error",
         "shadow map's wrong pixels: acne / detached / aliasing / resolution",
+        "area lights: mean / largest |fraction − exact|",
     ] {
         let _ = write!(h, "<th>{col}</th>");
     }
@@ -588,13 +635,13 @@ fn results_table(report: &Report, out: &Path, h: &mut String) {
                 super::method_link(&r.shadows, out),
                 escape(&r.status),
                 if r.exact { "yes" } else { "no" },
-                "<td>—</td>".repeat(9)
+                "<td>—</td>".repeat(10)
             );
             continue;
         }
         let _ = writeln!(
             h,
-            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td{noisy}>{:.1} ({:.1}–{:.1})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td><td>{}</td></tr>",
+            "<tr{class}><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td><td{noisy}>{:.1} ({:.1}–{:.1})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{:.4}%</td><td>{}</td><td>{}</td></tr>",
             super::method_link(&r.visibility, out),
             super::method_link(&r.shadows, out),
             escape(&r.status),
@@ -610,7 +657,8 @@ fn results_table(report: &Report, out: &Path, h: &mut String) {
             r.wrong_pixels,
             r.interior_pixels,
             100.0 * r.error_share,
-            r.map_errors.map_or(String::new(), |c| format!("{} / {} / {} / {}", c.acne, c.detached, c.aliasing, c.resolution))
+            r.map_errors.map_or(String::new(), |c| format!("{} / {} / {} / {}", c.acne, c.detached, c.aliasing, c.resolution)),
+            r.area_error.map_or(String::new(), |a| format!("{:.4} / {:.3}", a.mean, a.max))
         );
     }
     h.push_str("</tbody>\n</table>\n");

@@ -42,6 +42,17 @@ fn compare_reports_every_method_and_a_valid_page() {
     }
     // The approximate methods' error is measured, not assumed: none leaves shadows out.
     assert!(report.results.iter().any(|r| r.shadows == "none" && r.wrong_pixels > 100));
+    // The area light (light 3): the grid's error against the exact fraction is measured,
+    // and Nishita & Nakamae's stage has none beyond a grey level.
+    for r in report.results.iter().filter(|r| r.status == "ok") {
+        let e = r.area_error.unwrap_or_else(|| panic!("{} + {}: no area error", r.visibility, r.shadows));
+        assert!(e.pixels > 100, "{} + {}: {e:?}", r.visibility, r.shadows);
+        match r.shadows.as_str() {
+            "nishita-nakamae" => assert!(e.max <= 1.0 / 255.0, "{}: {e:?}", r.visibility),
+            "bouknight-kelley" | "crow" => assert!(e.mean > 0.01 && e.max > 0.1, "{}: {e:?}", r.visibility),
+            _ => {}
+        }
+    }
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     let doc = scraper::Html::parse_document(&html);
     assert!(doc.errors.is_empty(), "HTML parse errors: {:?}", doc.errors);
