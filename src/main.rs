@@ -509,7 +509,9 @@ struct BenchArgs {
 #[derive(clap::Args)]
 struct ScaleArgs {
     /// What to sweep: cubes (N per side), quads (depth complexity), spheres (triangles),
-    /// scattered / clustered (triangle count), size (triangle size), resolution (width).
+    /// scattered / clustered (triangle count), size (triangle size), resolution (width),
+    /// samples (N×N grid of a square light over the cubes; each point's error against the
+    /// exact fraction is measured too).
     #[arg(long, value_parser = parse::<Sweep>)]
     sweep: Sweep,
     /// Comma-separated values of the parameter.
@@ -934,9 +936,14 @@ fn scale_command(a: ScaleArgs) -> umbra::Result<()> {
         "frame ms: median (min–max)",
         opts.counter
     );
+    if opts.sweep == Sweep::Samples {
+        table = table.replace('\n', "  mean |fraction − exact| in the penumbra\n");
+    }
     for p in scale(&opts)? {
         let time = format!("{:.1} ({:.1}–{:.1})", p.time.median_ms, p.time.min_ms, p.time.max_ms);
-        table += &format!("{:>10} {:>9} + {:<34} {:>26}  {}\n", p.value, p.visibility, p.shadows, time, p.counter);
+        let error = p.area_error.map_or(String::new(), |e| format!("  {e:.4}"));
+        table +=
+            &format!("{:>10} {:>9} + {:<34} {:>26}  {}{error}\n", p.value, p.visibility, p.shadows, time, p.counter);
     }
     stdout(&table)?;
     say(&format!("wrote {}", a.out.display()))

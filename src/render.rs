@@ -509,6 +509,13 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
             id[a..b].fill(ctx.scene.polygons[run.poly as usize].face);
             for (k, (l, s, _)) in ctx.all_samples().enumerate() {
                 let lit = &lit[k * w as usize + run.x0 as usize..][..b - a];
+                if walker.whole_light(l) {
+                    // The stage's answer for the whole light is its fraction.
+                    if s == 0 {
+                        light[l][a..b].copy_from_slice(lit);
+                    }
+                    continue;
+                }
                 let share = 1.0 / ctx.samples[l].len() as f32;
                 // A light's first sample writes its lit fraction, the others add to it.
                 for (f, &v) in light[l][a..b].iter_mut().zip(lit) {

@@ -99,7 +99,7 @@ pub struct AreaError {
 
 impl AreaError {
     /// `got`'s area-light fractions against `exact`'s (the reference with exact fractions).
-    fn of(scene: &Scene, exact: &Frame, got: &Frame) -> AreaError {
+    pub(crate) fn of(scene: &Scene, exact: &Frame, got: &Frame) -> AreaError {
         let (mut pixels, mut sum, mut max) = (0, 0.0f64, 0.0f64);
         for (l, light) in scene.lights.iter().enumerate() {
             if !matches!(light.kind, crate::scene::LightKind::Area { .. }) {
@@ -264,6 +264,16 @@ pub fn compare(
 /// Whether `scene` has an area light.
 fn has_area_light(scene: &Scene) -> bool {
     scene.lights.iter().any(|l| matches!(l.kind, crate::scene::LightKind::Area { .. }))
+}
+
+/// The ray-cast reference frame of `scene` with each area light's exact fractions.
+pub(crate) fn exact_area_reference(scene: &Scene) -> Result<Frame> {
+    let opts = RenderOptions {
+        visibility: VisibilityMethod::RayCast,
+        shadows: ShadowMethod::RayCast,
+        ..RenderOptions::default()
+    };
+    Ok(with_exact_area_fractions(scene, &render(scene, &opts)?.frame))
 }
 
 /// The ray-cast `reference` with each area light's lit fractions replaced by the exact ones

@@ -13,6 +13,7 @@ use crate::scene::Scene;
 use crate::shadow::ShadowMethod;
 use crate::study::bench::{measure, Spread};
 use crate::visibility::VisibilityMethod;
+use glam::DVec3;
 #[cfg(feature = "plots")]
 use plotters::coord::combinators::{BindKeyPoints, LogCoord, WithKeyPoints};
 #[cfg(feature = "plots")]
@@ -39,11 +40,14 @@ pub enum Sweep {
     Size,
     /// The cubes scene at a resolution (value: width; height is 9/16 of it).
     Resolution,
+    /// The cubes scene under a 2×2 square light sampled by an N×N grid (value: N), each
+    /// point's error against the exact fraction measured (`Point::area_error`).
+    Samples,
 }
 
 impl Sweep {
     /// Names on the command line.
-    pub const NAMES: [(&'static str, Sweep); 7] = [
+    pub const NAMES: [(&'static str, Sweep); 8] = [
         ("cubes", Sweep::Cubes),
         ("quads", Sweep::Quads),
         ("spheres", Sweep::Spheres),
@@ -51,6 +55,7 @@ impl Sweep {
         ("clustered", Sweep::Clustered),
         ("size", Sweep::Size),
         ("resolution", Sweep::Resolution),
+        ("samples", Sweep::Samples),
     ];
 
     /// The sweep's name.
@@ -67,6 +72,7 @@ impl Sweep {
             Sweep::Scattered | Sweep::Clustered => "triangles",
             Sweep::Size => "triangle size",
             Sweep::Resolution => "image width",
+            Sweep::Samples => "samples per side",
         }
     }
 
@@ -81,6 +87,17 @@ impl Sweep {
             Sweep::Clustered => generate::scattered(value as u32, o.size, true, w, h),
             Sweep::Size => generate::scattered(o.count, value, false, w, h),
             Sweep::Resolution => generate::cubes(10, true, value as u32, (value * 9.0 / 16.0).max(1.0) as u32),
+            Sweep::Samples => {
+                // The cubes' point light made a 2×2 square light (as s1a is s1's).
+                let mut scene = generate::cubes(10, true, w, h)?;
+                let crate::scene::LightKind::Point { position: at } = scene.lights[0].kind else {
+                    return Err(Error::Internal("the cubes scene's light is not a point light".into()));
+                };
+                let n = value as u32;
+                let square = crate::Light::area(at - DVec3::new(1.0, 0.0, 1.0), DVec3::X * 2.0, DVec3::Z * 2.0, [n, n]);
+                scene.set_lights(vec![square])?;
+                Ok(scene)
+            }
         }
     }
 }
@@ -134,6 +151,9 @@ pub struct Point {
     pub time: Spread,
     /// The chosen counter.
     pub counter: u64,
+    /// On the samples sweep: the mean of `|fraction − exact|` over the visible pixels in the
+    /// exact penumbra (0 for the exact stage).
+    pub area_error: Option<f64>,
 }
 
 /// Runs the sweep, writes `scale.csv`, `scale.json` (the points with what they were
@@ -147,8 +167,13 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     }
     let mut points = Vec::new();
     let mut known = std::collections::BTreeSet::new();
+    // The exact fractions do not depend on the grid: worked out once, on the first scene.
+    let mut exact: Option<crate::Frame> = None;
     for (i, &value) in o.values.iter().enumerate() {
         let scene = o.sweep.scene(value, o)?;
+        if o.sweep == Sweep::Samples && exact.is_none() {
+            exact = Some(super::compare::exact_area_reference(&scene)?);
+        }
         for (v, s) in &o.methods {
             let opts = RenderOptions { visibility: *v, shadows: s.clone(), ..RenderOptions::default() };
             let m = measure(&scene, &opts, 1, o.runs)?;
@@ -156,6 +181,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
             let counters = if kind == "shadow" { &r.stats.shadow_counters } else { &r.stats.visibility_counters };
             known.extend(counters.iter().map(|(k, _)| k));
             let counter = counters.get(name);
+            let area_error = exact.as_ref().map(|e| super::compare::AreaError::of(&scene, e, &r.frame).mean);
             points.push(Point {
                 value,
                 visibility: v.name().into(),
@@ -163,6 +189,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
                 polygons: scene.polygons.len(),
                 time: m.frame,
                 counter,
+                area_error,
             });
         }
         // After the first point every method has reported its counters: a name none of them
@@ -176,12 +203,21 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
             )));
         }
     }
-    let mut csv = format!("{},visibility,shadows,polygons,median_ms,min_ms,max_ms,{}\n", o.sweep.name(), o.counter);
+    let mut csv =
+        format!("{},visibility,shadows,polygons,median_ms,min_ms,max_ms,{},area_error\n", o.sweep.name(), o.counter);
     for p in &points {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.3},{:.3},{:.3},{}",
-            p.value, p.visibility, p.shadows, p.polygons, p.time.median_ms, p.time.min_ms, p.time.max_ms, p.counter
+            "{},{},{},{},{:.3},{:.3},{:.3},{},{}",
+            p.value,
+            p.visibility,
+            p.shadows,
+            p.polygons,
+            p.time.median_ms,
+            p.time.min_ms,
+            p.time.max_ms,
+            p.counter,
+            p.area_error.map_or(String::new(), |e| format!("{e:.6}"))
         );
     }
     let about = super::About::now(format!(
@@ -211,6 +247,11 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         super::plot::save(&time, &o.out.join("time"))?;
         let counter = Plot { o, points: &points, label: &o.counter, y: |p: &Point| p.counter as f64, spread: None };
         super::plot::save(&counter, &o.out.join("counter"))?;
+        if o.sweep == Sweep::Samples {
+            let label = "mean |lit fraction − exact| in the penumbra";
+            let error = Plot { o, points: &points, label, y: |p: &Point| p.area_error.unwrap_or(0.0), spread: None };
+            super::plot::save(&error, &o.out.join("error"))?;
+        }
     }
     let path = o.out.join("index.html");
     std::fs::write(&path, page(o, &points, &about)).map_err(|e| Error::Write { path, source: e })?;
@@ -232,6 +273,9 @@ fn page(o: &ScaleOptions, points: &[Point], about: &super::About) -> String {
             "<p><img src=\"time.svg\" alt=\"frame time\"> <a href=\"time.png\">PNG</a></p>\n\
              <p><img src=\"counter.svg\" alt=\"counter\"> <a href=\"counter.png\">PNG</a></p>\n",
         );
+        if o.sweep == Sweep::Samples {
+            h.push_str("<p><img src=\"error.svg\" alt=\"error against the exact fraction\"> <a href=\"error.png\">PNG</a></p>\n");
+        }
     }
     let _ = write!(
         h,
@@ -264,6 +308,7 @@ fn x_axis(o: &ScaleOptions) -> (&'static str, fn(&Point) -> f64) {
     match o.sweep {
         Sweep::Size => ("triangle size", |p| p.value),
         Sweep::Resolution => ("pixels", |p| p.value * (p.value * 9.0 / 16.0).max(1.0).floor()),
+        Sweep::Samples => ("light samples (N×N)", |p| p.value * p.value),
         _ => ("polygons rendered", |p| p.polygons as f64),
     }
 }
@@ -276,7 +321,9 @@ type Bounds = fn(&Point) -> (f64, f64);
 /// A number as a tick label: short, without trailing zeros.
 fn tick(v: f64) -> String {
     let a = v.abs();
-    if a >= 1e6 {
+    if a > 0.0 && a < 0.01 {
+        format!("{v:.0e}")
+    } else if a >= 1e6 {
         format!("{}M", trim(v / 1e6))
     } else if a >= 1e4 {
         format!("{}k", trim(v / 1e3))

@@ -249,3 +249,28 @@ fn scale_notes_series_of_equal_values() {
     let yellow = png.pixels().filter(|p| p.0[0] > 200 && p.0[1] > 200 && p.0[2] < 100).count();
     assert_eq!(yellow, 0, "pale yellow on white");
 }
+
+/// The sampling-versus-analytic study: the grid's error against the exact fraction falls as
+/// its side grows, the exact stage's is nothing, and the error is plotted.
+#[test]
+fn the_samples_sweep_measures_the_grid_against_the_exact_fraction() {
+    use umbra::study::scale::{scale, Sweep};
+    let out = tmp("scale-samples");
+    let methods = vec![
+        (umbra::VisibilityMethod::Scanline, ShadowMethod::Crow(Default::default())),
+        (umbra::VisibilityMethod::Scanline, ShadowMethod::NishitaNakamae),
+    ];
+    let opts = umbra::study::scale::ScaleOptions {
+        sweep: Sweep::Samples,
+        counter: "shadow.pairs".into(),
+        ..quads_sweep(&out, vec![1.0, 4.0, 8.0], methods)
+    };
+    let points = scale(&opts).unwrap();
+    let error = |shadows: &str| -> Vec<f64> {
+        points.iter().filter(|p| p.shadows == shadows).map(|p| p.area_error.unwrap()).collect()
+    };
+    let (grid, exact) = (error("crow"), error("nishita-nakamae"));
+    assert!(grid[0] > 0.1 && grid[0] > grid[1] && grid[1] > grid[2] && grid[2] > 0.0, "{grid:?}");
+    assert_eq!(exact, vec![0.0; 3]);
+    assert!(out.join("error.svg").exists());
+}
