@@ -14,12 +14,7 @@ pub(crate) fn check(what: impl std::fmt::Display, bytes: u64) -> Result<()> {
     if bytes <= MEMORY_BUDGET {
         return Ok(());
     }
-    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
-    Err(Error::InvalidOption(format!(
-        "{what} would need about {:.1} GiB, more than umbra's memory budget of {:.0} GiB",
-        gib(bytes),
-        gib(MEMORY_BUDGET)
-    )))
+    Err(Error::OverBudget { what: what.to_string(), bytes, budget: MEMORY_BUDGET })
 }
 
 /// `a * b` saturating: estimates never wrap.

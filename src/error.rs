@@ -91,15 +91,31 @@ pub enum Error {
         source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// A request that the engine cannot carry out: an unknown method name, an option or a
-    /// scene built by the API with values out of range, work beyond the memory budget.
+    /// scene built by the API with values out of range.
     #[error("{0}")]
     InvalidOption(String),
+    /// Work that would need more memory than the engine's budget (`budget`, bytes): nothing
+    /// was allocated.
+    #[error("{what} would need about {:.1} GiB, more than umbra's memory budget of {:.0} GiB", gib(.bytes), gib(.budget))]
+    OverBudget {
+        /// What would have been made.
+        what: String,
+        /// The bytes it would need.
+        bytes: u64,
+        /// The budget.
+        budget: u64,
+    },
     /// A method that does not apply to this scene (planar shadows with no receiver).
     #[error("{0}")]
     NotApplicable(String),
     /// A stage failed where it should not have: a defect in umbra, not in the input.
     #[error("internal error (a defect in umbra; please report it): {0}")]
     Internal(String),
+}
+
+/// Bytes in GiB, for messages.
+fn gib(bytes: &u64) -> f64 {
+    *bytes as f64 / (1u64 << 30) as f64
 }
 
 impl Error {

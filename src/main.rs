@@ -940,6 +940,10 @@ fn scale_command(a: ScaleArgs) -> umbra::Result<()> {
         table = table.replace('\n', "  mean |fraction − exact| in the penumbra\n");
     }
     for p in scale(&opts)? {
+        if let Some(why) = &p.refused {
+            table += &format!("{:>10} {:>9} + {:<34} refused: {why}\n", p.value, p.visibility, p.shadows);
+            continue;
+        }
         let time = format!("{:.1} ({:.1}–{:.1})", p.time.median_ms, p.time.min_ms, p.time.max_ms);
         let error = p.area_error.map_or(String::new(), |e| format!("  {e:.4}"));
         table +=

@@ -154,6 +154,9 @@ pub struct Point {
     /// On the samples sweep: the mean of `|fraction − exact|` over the visible pixels in the
     /// exact penumbra (0 for the exact stage).
     pub area_error: Option<f64>,
+    /// Why the method was not run at this point (over the memory budget, or not applicable
+    /// to the scene); its time and counter are then 0, and the plots leave it out.
+    pub refused: Option<String>,
 }
 
 /// Runs the sweep, writes `scale.csv`, `scale.json` (the points with what they were
@@ -176,7 +179,25 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         }
         for (v, s) in &o.methods {
             let opts = RenderOptions { visibility: *v, shadows: s.clone(), ..RenderOptions::default() };
-            let m = measure(&scene, &opts, 1, o.runs)?;
+            let m = match measure(&scene, &opts, 1, o.runs) {
+                Ok(m) => m,
+                // A method refused at one point (a shadow map per sample of a fine grid) is
+                // said so, and the sweep goes on.
+                Err(e @ (Error::OverBudget { .. } | Error::NotApplicable(_))) => {
+                    points.push(Point {
+                        value,
+                        visibility: v.name().into(),
+                        shadows: s.label(),
+                        polygons: scene.polygons.len(),
+                        time: Spread { median_ms: 0.0, min_ms: 0.0, max_ms: 0.0 },
+                        counter: 0,
+                        area_error: None,
+                        refused: Some(e.to_string()),
+                    });
+                    continue;
+                }
+                Err(e) => return Err(e),
+            };
             let r = &m.last;
             let counters = if kind == "shadow" { &r.stats.shadow_counters } else { &r.stats.visibility_counters };
             known.extend(counters.iter().map(|(k, _)| k));
@@ -190,11 +211,12 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
                 time: m.frame,
                 counter,
                 area_error,
+                refused: None,
             });
         }
         // After the first point every method has reported its counters: a name none of them
         // knows would plot zeros everywhere.
-        if i == 0 && !known.contains(name) {
+        if i == 0 && !known.is_empty() && !known.contains(name) {
             let names: Vec<&str> = known.iter().copied().collect();
             return Err(Error::InvalidOption(format!(
                 "no method here counts '{}' (known {kind} counters: {})",
@@ -203,12 +225,15 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
             )));
         }
     }
-    let mut csv =
-        format!("{},visibility,shadows,polygons,median_ms,min_ms,max_ms,{},area_error\n", o.sweep.name(), o.counter);
+    let mut csv = format!(
+        "{},visibility,shadows,polygons,median_ms,min_ms,max_ms,{},area_error,refused\n",
+        o.sweep.name(),
+        o.counter
+    );
     for p in &points {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.3},{:.3},{:.3},{},{}",
+            "{},{},{},{},{:.3},{:.3},{:.3},{},{},\"{}\"",
             p.value,
             p.visibility,
             p.shadows,
@@ -217,7 +242,8 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
             p.time.min_ms,
             p.time.max_ms,
             p.counter,
-            p.area_error.map_or(String::new(), |e| format!("{e:.6}"))
+            p.area_error.map_or(String::new(), |e| format!("{e:.6}")),
+            p.refused.as_deref().unwrap_or("").replace('"', "'")
         );
     }
     let about = super::About::now(format!(
@@ -236,20 +262,16 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     std::fs::write(&path, csv).map_err(|e| Error::Write { path, source: e })?;
     #[cfg(feature = "plots")]
     {
+        let measured: Vec<Point> = points.iter().filter(|p| p.refused.is_none()).cloned().collect();
+        let points = &measured;
         let spread: Bounds = |p| (p.time.min_ms, p.time.max_ms);
-        let time = Plot {
-            o,
-            points: &points,
-            label: "frame time (ms)",
-            y: |p: &Point| p.time.median_ms,
-            spread: Some(spread),
-        };
+        let time = Plot { o, points, label: "frame time (ms)", y: |p: &Point| p.time.median_ms, spread: Some(spread) };
         super::plot::save(&time, &o.out.join("time"))?;
-        let counter = Plot { o, points: &points, label: &o.counter, y: |p: &Point| p.counter as f64, spread: None };
+        let counter = Plot { o, points, label: &o.counter, y: |p: &Point| p.counter as f64, spread: None };
         super::plot::save(&counter, &o.out.join("counter"))?;
         if o.sweep == Sweep::Samples {
             let label = "mean |lit fraction − exact| in the penumbra";
-            let error = Plot { o, points: &points, label, y: |p: &Point| p.area_error.unwrap_or(0.0), spread: None };
+            let error = Plot { o, points, label, y: |p: &Point| p.area_error.unwrap_or(0.0), spread: None };
             super::plot::save(&error, &o.out.join("error"))?;
         }
     }
@@ -284,6 +306,18 @@ fn page(o: &ScaleOptions, points: &[Point], about: &super::About) -> String {
         super::escape(&o.counter)
     );
     for p in points {
+        if let Some(why) = &p.refused {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{} + {}</td><td>{}</td><td colspan=\"4\">refused: {}</td></tr>",
+                p.value,
+                super::method_link(&p.visibility, &o.out),
+                super::method_link(&p.shadows, &o.out),
+                p.polygons,
+                super::escape(why)
+            );
+            continue;
+        }
         let _ = writeln!(
             h,
             "<tr><td>{}</td><td>{} + {}</td><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td><td>{}</td></tr>",

@@ -274,3 +274,25 @@ fn the_samples_sweep_measures_the_grid_against_the_exact_fraction() {
     assert_eq!(exact, vec![0.0; 3]);
     assert!(out.join("error.svg").exists());
 }
+
+/// A method over the memory budget at one point of a sweep is marked refused there, with the
+/// budget's message, and the sweep goes on; the error is typed.
+#[test]
+fn a_sweep_point_over_the_budget_is_refused_and_the_sweep_goes_on() {
+    use umbra::study::scale::{scale, Sweep};
+    let out = tmp("scale-refused");
+    let williams = (umbra::VisibilityMethod::Scanline, ShadowMethod::Williams(Default::default()));
+    let opts = umbra::study::scale::ScaleOptions {
+        sweep: Sweep::Samples,
+        counter: "shadow.map_lookups".into(),
+        ..quads_sweep(&out, vec![1.0, 12.0], vec![williams])
+    };
+    let points = scale(&opts).unwrap();
+    assert!(points[0].refused.is_none() && points[0].time.median_ms > 0.0);
+    let why = points[1].refused.as_deref().unwrap();
+    assert!(why.contains("memory budget"), "{why}");
+    assert!(std::fs::read_to_string(out.join("index.html")).unwrap().contains("refused: "));
+    let scene = umbra::study::scale::Sweep::Samples.scene(12.0, &opts).unwrap();
+    let opts = umbra::RenderOptions { shadows: ShadowMethod::Williams(Default::default()), ..Default::default() };
+    assert!(matches!(umbra::render(&scene, &opts), Err(umbra::Error::OverBudget { budget, .. }) if budget == 8 << 30));
+}
