@@ -39,6 +39,7 @@ use super::overlay::{Interval, Overlay, OverlayWalker, ReceiverTable};
 use super::projection::{bounding_rectangle, edge_on, Projector, Target};
 use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
 use crate::bvh::Bvh;
+use crate::geometry::convex_split::is_convex;
 use crate::geometry::{clip_polygon, Plane};
 use crate::scene::{LightKind, LightSample, Scene};
 use crate::stats::Counters;
@@ -231,7 +232,7 @@ fn unhidden(hidden: &[Vec<DVec2>], sweep: &mut Sweep) -> f64 {
         if clipped.len() < 3 {
             continue;
         }
-        if area(clipped) >= 1.0 - 1e-12 && convex2(clipped) {
+        if area(clipped) >= 1.0 - 1e-12 && is_convex(clipped) {
             return 0.0;
         }
         if parts.len() == k {
@@ -244,7 +245,7 @@ fn unhidden(hidden: &[Vec<DVec2>], sweep: &mut Sweep) -> f64 {
     let covered = match parts {
         [] => 0.0,
         [a] => area(a),
-        [a, b] if convex2(a) && convex2(b) => {
+        [a, b] if is_convex(a) && is_convex(b) => {
             clip_convex(a, b, clipped, tmp);
             area(a) + area(b) - area(clipped)
         }
@@ -262,19 +263,6 @@ fn unhidden(hidden: &[Vec<DVec2>], sweep: &mut Sweep) -> f64 {
 /// A share of the light's area below which a part left or hidden counts as nothing
 /// (far below an 8-bit grey level's 1/255).
 const SLIVER: f64 = 1e-9;
-
-/// Whether a ring in the plane is convex (every turn one way).
-fn convex2(ring: &[DVec2]) -> bool {
-    let n = ring.len();
-    let (mut left, mut right) = (false, false);
-    for k in 0..n {
-        let (a, b, c) = (ring[k], ring[(k + 1) % n], ring[(k + 2) % n]);
-        let t = (b - a).perp_dot(c - b);
-        left |= t > 0.0;
-        right |= t < 0.0;
-    }
-    !(left && right)
-}
 
 /// The area of the unit square covered by the union of `polygons` (even-odd within each).
 fn covered_area(
