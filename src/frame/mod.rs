@@ -354,7 +354,6 @@ pub(crate) fn write_png(img: image::DynamicImage, path: &Path) -> Result<()> {
 }
 
 /// The image encoded as PNG, in memory.
-#[cfg(feature = "explore")]
 pub(crate) fn encode_png(img: image::DynamicImage) -> Result<Vec<u8>> {
     png_bytes(&img, Path::new("(in memory)"))
 }

@@ -16,8 +16,9 @@
 //! moves the first light (a point, spot or area light's position or corner; a directional
 //! light then shines from there toward the middle of the scene).
 //!
-//! [`serve`] answers on 127.0.0.1 only, with `axum`; [`export`] writes the same page as
-//! static files with every line precomputed, readable straight from disk.
+//! The `umbra` command serves it on 127.0.0.1 only (its server lives with the tools, in
+//! `tools/src/serve.rs`); [`export`] writes the same page as static files with every line
+//! precomputed, readable straight from disk.
 
 use super::trace::{trace, trace_lines, LineTrace};
 use crate::error::{Error, Result};
@@ -69,7 +70,8 @@ impl Response {
         }
     }
 
-    fn error(status: u16, message: &str) -> Response {
+    /// An error of HTTP status `status`: `{"error": message}`, as the page shows it.
+    pub fn error(status: u16, message: &str) -> Response {
         let body = json!({ "error": message }).to_string();
         Response { status, content_type: "application/json", body: body.into_bytes() }
     }
@@ -388,41 +390,6 @@ fn point(value: &str) -> Result<DVec3> {
         [x, y, z] if value.split(',').count() == 3 => Ok(DVec3::new(x, y, z)),
         _ => Err(Error::InvalidOption(format!("light '{value}' is not three finite numbers x,y,z"))),
     }
-}
-
-/// Serves the page on `127.0.0.1:port` (0: any free port) until the process ends, calling
-/// `ready` with the address once it listens. Requests are answered on a thread pool, the
-/// engine's work off the server's own threads.
-pub fn serve(explorer: Explorer, port: u16, ready: impl FnOnce(&str)) -> Result<()> {
-    use axum::http::{header, Method, StatusCode, Uri};
-    let failed = |what: &str, e: std::io::Error| Error::InvalidOption(format!("{what}: {e}"));
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .enable_io()
-        .build()
-        .map_err(|e| failed("cannot start the server", e))?;
-    runtime.block_on(async move {
-        let listener = tokio::net::TcpListener::bind(("127.0.0.1", port))
-            .await
-            .map_err(|e| failed(&format!("cannot listen on 127.0.0.1:{port}"), e))?;
-        let address = listener.local_addr().map_err(|e| failed("the server has no address", e))?;
-        ready(&format!("http://{address}/"));
-        let explorer = Arc::new(explorer);
-        let app = axum::Router::new().fallback(move |method: Method, uri: Uri| {
-            let explorer = explorer.clone();
-            async move {
-                let r = if method == Method::GET {
-                    let url = uri.path_and_query().map_or("/", |p| p.as_str()).to_owned();
-                    let answer = tokio::task::spawn_blocking(move || explorer.handle(&url)).await;
-                    answer.unwrap_or_else(|e| Response::error(500, &format!("the engine failed: {e}")))
-                } else {
-                    Response::error(405, "only GET is served")
-                };
-                let status = StatusCode::from_u16(r.status).unwrap_or(StatusCode::INTERNAL_SERVER_ERROR);
-                (status, [(header::CONTENT_TYPE, r.content_type)], r.body)
-            }
-        });
-        axum::serve(listener, app).await.map_err(|e| failed("the server stopped", e))
-    })
 }
 
 /// Writes the page with every line of every applicable stage precomputed into `dir`, at

@@ -6,7 +6,6 @@
 
 pub mod bench;
 pub mod compare;
-#[cfg(feature = "explore")]
 pub mod explore;
 pub mod map_errors;
 #[cfg(feature = "plots")]

@@ -8,7 +8,6 @@ mod common;
 
 mod approximate;
 mod area;
-mod cli;
 mod explore;
 mod fuzz;
 mod loading;

@@ -14,6 +14,10 @@ fn tmp(name: &str) -> std::path::PathBuf {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "plots"),
+    ignore = "it checks the charts: run with the `plots` feature, as `cargo test` at the top does"
+)]
 fn compare_reports_every_method_and_a_valid_page() {
     let mut scene = Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/lights.toml")).unwrap();
     {
@@ -174,6 +178,10 @@ fn quads_sweep(
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "plots"),
+    ignore = "it checks the charts: run with the `plots` feature, as `cargo test` at the top does"
+)]
 fn scale_writes_csv_and_plots() {
     use umbra::study::scale::scale;
     let out = tmp("scale");
@@ -208,6 +216,10 @@ fn scale_writes_csv_and_plots() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "plots"),
+    ignore = "it checks the charts: run with the `plots` feature, as `cargo test` at the top does"
+)]
 fn the_scale_legend_holds_its_longest_method_name() {
     let out = tmp("scale-legend");
     let methods = vec![(umbra::VisibilityMethod::Scanline, "atherton-weiler-greenberg".parse().unwrap())];
@@ -234,6 +246,10 @@ fn unknown_method_names_list_the_known_ones() {
 /// Series of equal values in scale's charts are noted in the legend (their lines lie on one
 /// another), and the charts draw in the colour-blind-safe palette, with no pale yellow.
 #[test]
+#[cfg_attr(
+    not(feature = "plots"),
+    ignore = "it checks the charts: run with the `plots` feature, as `cargo test` at the top does"
+)]
 fn scale_notes_series_of_equal_values() {
     let out = tmp("scale-equal");
     let methods = vec![
@@ -253,6 +269,10 @@ fn scale_notes_series_of_equal_values() {
 /// The sampling-versus-analytic study: the grid's error against the exact fraction falls as
 /// its side grows, the exact stage's is nothing, and the error is plotted.
 #[test]
+#[cfg_attr(
+    not(feature = "plots"),
+    ignore = "it checks the charts: run with the `plots` feature, as `cargo test` at the top does"
+)]
 fn the_samples_sweep_measures_the_grid_against_the_exact_fraction() {
     use umbra::study::scale::{scale, Sweep};
     let out = tmp("scale-samples");

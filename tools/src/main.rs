@@ -1,11 +1,10 @@
 //! The `umbra` command line: a thin layer over the library.
 
-mod cli {
-    pub mod progress;
-}
+mod progress;
+mod serve;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use cli::progress::TerminalBar;
+use progress::TerminalBar;
 use std::alloc::{GlobalAlloc, Layout};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -143,7 +142,6 @@ enum Command {
     /// Watch the algorithms work: a page in the browser, served on 127.0.0.1, that draws what
     /// `trace` prints for any line and stage, with the frame, its counters and the pixels
     /// where a stage differs from ray-cast.
-    #[cfg(feature = "explore")]
     Explore(ExploreArgs),
     /// Write a generated benchmark scene (scene file plus OBJ meshes).
     Generate(GenerateArgs),
@@ -564,8 +562,6 @@ struct TraceArgs {
     #[command(flatten)]
     shadow: ShadowArgs,
 }
-
-#[cfg(feature = "explore")]
 #[derive(clap::Args)]
 struct ExploreArgs {
     /// The scene file.
@@ -592,8 +588,6 @@ struct ExploreArgs {
     #[arg(long)]
     paper: bool,
 }
-
-#[cfg(feature = "explore")]
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let bad = || format!("'{s}' is not WIDTHxHEIGHT with each from 1 to 640 and 480");
     let (w, h) = s.split_once('x').ok_or_else(bad)?;
@@ -602,10 +596,9 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
         _ => Err(bad()),
     }
 }
-
-#[cfg(feature = "explore")]
 fn explore(a: ExploreArgs) -> umbra::Result<()> {
-    use umbra::study::explore::{export, serve, Explorer};
+    use serve::serve;
+    use umbra::study::explore::{export, Explorer};
     let scene = Scene::load(&a.scene)?;
     let name = a.scene.file_name().map_or_else(|| a.scene.display().to_string(), |n| n.to_string_lossy().into_owned());
     let explorer = Explorer::new(scene, name).with_paper(a.paper);
@@ -626,7 +619,6 @@ fn explore(a: ExploreArgs) -> umbra::Result<()> {
 }
 
 /// Asks the desktop to open `address`; says so when it cannot.
-#[cfg(feature = "explore")]
 fn open_browser(address: &str) {
     let opener = if cfg!(target_os = "macos") { "open" } else { "xdg-open" };
     if std::process::Command::new(opener).arg(address).spawn().is_err() {
@@ -737,7 +729,6 @@ fn run(cli: Cli) -> umbra::Result<()> {
         Command::Bench(a) => bench_command(a),
         Command::Scale(a) => scale_command(a),
         Command::Trace(a) => trace_command(a),
-        #[cfg(feature = "explore")]
         Command::Explore(a) => explore(a),
         Command::ExportShadows(e) => export_shadows_command(e),
         Command::Generate(g) => generate_command(g),
@@ -1069,10 +1060,10 @@ fn check_png_name(path: &std::path::Path) -> umbra::Result<()> {
 
 /// Writes the image as PNG, in one write so that a failed write is an error; missing
 /// folders on the way are made first, as `--aov` and `generate` make theirs.
-fn write_png(img: image::RgbImage, path: &std::path::Path) -> umbra::Result<()> {
+fn write_png(img: umbra::image::RgbImage, path: &std::path::Path) -> umbra::Result<()> {
     check_png_name(path)?;
     let mut bytes = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), umbra::image::ImageFormat::Png)
         .map_err(|e| Error::Image { path: path.to_owned(), source: e.into() })?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| Error::Write { path: dir.to_owned(), source: e })?;

@@ -19,7 +19,7 @@ fn tmp(name: &str) -> std::path::PathBuf {
 #[test]
 fn render_writes_image_aovs_and_stats() {
     let d = tmp("render");
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/lights.toml");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/lights.toml");
     let out = umbra()
         .args(["render", scene, "-o"])
         .arg(d.join("o.png"))
@@ -48,7 +48,7 @@ fn render_writes_image_aovs_and_stats() {
 /// stages have no such entry.
 #[test]
 fn stats_give_a_shadow_maps_errors_by_cause() {
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/lights.toml");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/lights.toml");
     let stats = |shadows: &str| -> serde_json::Value {
         let out = umbra().args(["render", scene, "-o", "/dev/null", "--stats", "--shadows", shadows]).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -114,7 +114,7 @@ fn generate_writes_a_loadable_scene() {
 #[test]
 fn export_shadows_writes_an_obj_of_lit_detail_polygons() {
     let d = tmp("export");
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.toml");
     let out = umbra().args(["export-shadows", scene, "-o"]).arg(d.join("lit.obj")).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(d.join("lit.obj")).unwrap();
@@ -138,7 +138,7 @@ fn refused(args: &[&str], want: &str) {
     assert!(err.contains(want), "{args:?}: {err}");
 }
 
-const SMALL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robustness/crow_pentagram_even_odd.toml");
+const SMALL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/robustness/crow_pentagram_even_odd.toml");
 
 #[test]
 fn failed_writes_are_errors() {
@@ -333,7 +333,7 @@ fn nothing_silent() {
 
 #[test]
 fn receiver_makes_planar_shadows_usable_on_any_scene() {
-    let cornell = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell.toml");
+    let cornell = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.toml");
     let d = tmp("receiver");
     let out = d.join("planar.png");
     let out = out.to_str().unwrap();
@@ -478,4 +478,25 @@ fn bench_rows_have_their_own_peak_memory_and_the_table_fits() {
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(text.lines().next().is_some_and(|h| h.contains("peak MB") && h.contains("speed-up")), "{text}");
     assert!(text.lines().all(|l| l.chars().count() <= 120), "wider than 120 columns:\n{text}");
+}
+
+#[test]
+fn the_command_stops_on_a_bad_scene_before_serving() {
+    let out = umbra().args(["explore", "no-such-scene.toml", "--port", "0"]).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("no-such-scene.toml") && !err.contains("http://"), "{err}");
+
+    let dir = std::env::temp_dir().join(format!("umbra-explore-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("keep.txt"), "mine").unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.toml");
+    let out = umbra().args(["explore", scene, "--export"]).arg(&dir).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("pass --force"));
+    let out = umbra().args(["explore", scene, "--size", "9999x10", "--export"]).arg(&dir).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("WIDTHxHEIGHT"));
+    std::fs::remove_dir_all(&dir).unwrap();
 }
