@@ -252,6 +252,20 @@ impl Default for VolumeOptions {
     }
 }
 
+/// Every stage's settings at once, as a command line or a notebook holds them;
+/// [`ShadowMethod::with_settings`] gives a method those of its own stage.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StageSettings {
+    /// Bouknight-Kelley's.
+    pub bouknight_kelley: BouknightKelleyOptions,
+    /// Atherton-Weiler-Greenberg's.
+    pub atherton_weiler_greenberg: AthertonWeilerGreenbergOptions,
+    /// The shadow volumes', counted per span (Crow) or in a stencil.
+    pub volumes: VolumeOptions,
+    /// Williams' shadow maps'.
+    pub williams: WilliamsOptions,
+}
+
 /// What every shadow stage is prepared from.
 pub(crate) struct ShadowContext<'a> {
     /// The scene.
@@ -567,6 +581,50 @@ impl ShadowMethod {
         }
     }
 
+    /// What the stage does, in a few sentences for a reader of the study tools (`umbra
+    /// explore` shows it above the stage's trace).
+    pub fn description(&self) -> &'static str {
+        match self {
+            ShadowMethod::None => "No shadows: every light sample reaches every point on its seen side.",
+            ShadowMethod::RayCast => "The reference: one shadow ray per pixel and light sample, through a BVH.",
+            ShadowMethod::BouknightKelley(_) => {
+                "Appel / Bouknight-Kelley (1970): every polygon's shadow projected from the light onto each \
+                 receiver's plane (pairs kept by the sphere prefilter). For each run, the shadow polygons on \
+                 its receiver are walked with their own active edges; then a segment no shadow polygon touches \
+                 is lit, one a shadow polygon covers fully is in shadow, and one covered partly is split at \
+                 that polygon's edges and each part examined again. Below: the segments of the picked run, \
+                 one row per depth of the recursion."
+            }
+            ShadowMethod::Crow(_) => {
+                "Crow (1977): shadow volumes bounded by shadow polygons. Along the run, each shadow polygon \
+                 in front of the visible point adds +1 (entering a volume) or -1 (leaving one); near caps \
+                 carry the eye's own count. Where the count is 0 the point is lit. Below: each polygon's \
+                 contribution over the pixels where it holds, and the count along the run."
+            }
+            ShadowMethod::AthertonWeilerGreenberg(_) => {
+                "Atherton, Weiler & Greenberg (1978): hidden-surface removal from the light (Weiler-Atherton \
+                 clipping) leaves the lit parts of every polygon as detail polygons, merged into the model. \
+                 A pixel is lit where a lit detail polygon of its polygon covers it. Below: the detail \
+                 polygons over the picked run."
+            }
+            ShadowMethod::Williams(_) => {
+                "Williams (1978): a depth map rendered from the light; a point is lit where it is no farther \
+                 from the light than the map's depth at its texel (with bias and percentage-closer filtering). \
+                 Approximate: the red pixels differ from ray-cast."
+            }
+            ShadowMethod::StencilVolume(_) => {
+                "Shadow volumes counted per pixel in a stencil buffer (Heidmann 1991): the z-buffer version \
+                 of Crow's count, rasterised before the frame is shaded."
+            }
+            ShadowMethod::Planar => "Blinn (1988): shadows projected onto marked receiver planes. Approximate.",
+            ShadowMethod::NishitaNakamae => {
+                "Nishita & Nakamae (1983-85): umbra and penumbra polygons from the light's corners; pixels \
+                 in an umbra are dark and outside every penumbra lit, a span at a time; only in the penumbra \
+                 is the visible part of an area light clipped out and measured: its exact lit fraction."
+            }
+        }
+    }
+
     /// The method as its paper publishes it, with none of our engineering (`--paper`):
     /// Bouknight-Kelley, Atherton-Weiler-Greenberg and Crow's volumes (per span or in a
     /// stencil) with every step of ours off ([`BouknightKelleyOptions::PAPER`] keeping the
@@ -594,7 +652,118 @@ impl ShadowMethod {
             ShadowMethod::StencilVolume(v) => {
                 ShadowMethod::StencilVolume(VolumeOptions { counting: v.counting, ..VolumeOptions::PAPER })
             }
-            other => other.clone(),
+            ShadowMethod::None
+            | ShadowMethod::RayCast
+            | ShadowMethod::Williams(_)
+            | ShadowMethod::Planar
+            | ShadowMethod::NishitaNakamae => self.clone(),
+        }
+    }
+
+    /// The method with the settings of its own stage from `settings` (a stage without
+    /// settings is left as it is): how a command line or a notebook that holds every
+    /// stage's settings at once configures whichever method it is given.
+    ///
+    /// ```
+    /// use umbra::shadow::{Counting, ShadowMethod, StageSettings, VolumeOptions};
+    /// let mut settings = StageSettings::default();
+    /// settings.volumes.counting = Counting::ZFail;
+    /// let crow: ShadowMethod = "crow".parse()?;
+    /// assert_eq!(crow.with_settings(&settings), ShadowMethod::Crow(settings.volumes));
+    /// assert_eq!(ShadowMethod::RayCast.with_settings(&settings), ShadowMethod::RayCast);
+    /// # Ok::<(), umbra::Error>(())
+    /// ```
+    pub fn with_settings(&self, settings: &StageSettings) -> ShadowMethod {
+        match self {
+            ShadowMethod::BouknightKelley(_) => ShadowMethod::BouknightKelley(settings.bouknight_kelley),
+            ShadowMethod::AthertonWeilerGreenberg(_) => {
+                ShadowMethod::AthertonWeilerGreenberg(settings.atherton_weiler_greenberg)
+            }
+            ShadowMethod::Crow(_) => ShadowMethod::Crow(settings.volumes),
+            ShadowMethod::StencilVolume(_) => ShadowMethod::StencilVolume(settings.volumes),
+            ShadowMethod::Williams(_) => ShadowMethod::Williams(settings.williams.clone()),
+            ShadowMethod::None | ShadowMethod::RayCast | ShadowMethod::Planar | ShadowMethod::NishitaNakamae => {
+                self.clone()
+            }
+        }
+    }
+
+    /// The settings of the method that a study tells apart, each once, the default first:
+    /// its paper path; the shadow volumes' other countings (and, for Crow, the count uncut
+    /// by the sight hull); Bouknight-Kelley without its prefilter and without its solid cull.
+    /// The exactness tests check every one of them that [`ShadowMethod::is_exact`].
+    ///
+    /// ```
+    /// use umbra::ShadowMethod;
+    /// let crow: ShadowMethod = "crow".parse()?;
+    /// let labels: Vec<String> = crow.variants().iter().map(|m| m.command_line()).collect();
+    /// assert_eq!(labels[0], "crow");
+    /// assert!(labels.contains(&"crow --crow-count zfail".to_string()));
+    /// assert!(labels.contains(&"crow --paper".to_string()));
+    /// # Ok::<(), umbra::Error>(())
+    /// ```
+    pub fn variants(&self) -> Vec<ShadowMethod> {
+        let mut out = vec![self.clone()];
+        match self {
+            ShadowMethod::BouknightKelley(o) => {
+                out.push(ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false, ..*o }));
+                out.push(ShadowMethod::BouknightKelley(BouknightKelleyOptions { solid_cull: false, ..*o }));
+            }
+            ShadowMethod::Crow(v) => {
+                out.push(ShadowMethod::Crow(VolumeOptions { counting: volumes::Counting::ZFail, ..*v }));
+                out.push(ShadowMethod::Crow(VolumeOptions { sight_cuts: false, ..*v }));
+                out.push(ShadowMethod::Crow(VolumeOptions { counting: volumes::Counting::NaiveZPass, ..*v }));
+            }
+            ShadowMethod::StencilVolume(v) => {
+                out.push(ShadowMethod::StencilVolume(VolumeOptions { counting: volumes::Counting::ZFail, ..*v }));
+            }
+            ShadowMethod::AthertonWeilerGreenberg(_)
+            | ShadowMethod::None
+            | ShadowMethod::RayCast
+            | ShadowMethod::Williams(_)
+            | ShadowMethod::Planar
+            | ShadowMethod::NishitaNakamae => {}
+        }
+        let paper = self.as_published();
+        if self.has_paper_path() && !out.contains(&paper) {
+            out.push(paper);
+        }
+        out
+    }
+
+    /// Whether the stage keeps polygons of its own to draw over the image
+    /// ([`crate::RenderOptions::outlines`], `umbra render --debug shadow-polygons`): the
+    /// shadow polygons of Bouknight-Kelley and Crow, Atherton-Weiler-Greenberg's detail
+    /// polygons, the planar shadows.
+    pub fn has_outlines(&self) -> bool {
+        match self {
+            ShadowMethod::BouknightKelley(_)
+            | ShadowMethod::AthertonWeilerGreenberg(_)
+            | ShadowMethod::Crow(_)
+            | ShadowMethod::Planar => true,
+            ShadowMethod::None
+            | ShadowMethod::RayCast
+            | ShadowMethod::Williams(_)
+            | ShadowMethod::StencilVolume(_)
+            | ShadowMethod::NishitaNakamae => false,
+        }
+    }
+
+    /// Whether the method gives an area light the exact fraction of `docs/scene-format.md`
+    /// §3 (the part of the light a point sees), not the fraction of its grid of samples:
+    /// such a stage is judged against the exact fraction (`reference::exact_fraction`), the
+    /// others against ray-cast.
+    pub fn exact_area_fraction(&self) -> bool {
+        match self {
+            ShadowMethod::NishitaNakamae => true,
+            ShadowMethod::None
+            | ShadowMethod::RayCast
+            | ShadowMethod::BouknightKelley(_)
+            | ShadowMethod::Crow(_)
+            | ShadowMethod::AthertonWeilerGreenberg(_)
+            | ShadowMethod::Williams(_)
+            | ShadowMethod::StencilVolume(_)
+            | ShadowMethod::Planar => false,
         }
     }
 
@@ -622,7 +791,8 @@ impl ShadowMethod {
                     on.push((!o.solid_cull, "--no-solid-cull".into()));
                 }
             }
-            ShadowMethod::AthertonWeilerGreenberg(o) if !paper => {
+            ShadowMethod::AthertonWeilerGreenberg(_) if paper => {}
+            ShadowMethod::AthertonWeilerGreenberg(o) => {
                 on.push((!o.convex_split, "--no-convex-split".into()));
                 on.push((!o.backgrounds, "--no-backgrounds".into()));
                 on.push((!o.lone_sheets, "--no-lone-sheets".into()));
@@ -640,7 +810,7 @@ impl ShadowMethod {
                 }
             }
             ShadowMethod::Williams(o) => on.extend(o.flags().into_iter().map(|f| (true, f))),
-            _ => {}
+            ShadowMethod::None | ShadowMethod::RayCast | ShadowMethod::Planar | ShadowMethod::NishitaNakamae => {}
         }
         let mut flags = vec![self.name().to_string()];
         flags.extend(on.into_iter().filter(|(set, _)| *set).map(|(_, f)| f));

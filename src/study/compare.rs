@@ -230,7 +230,7 @@ pub fn compare(
                 None => MethodResult::not_run(v, s, status),
                 Some(m) => {
                     let judge = match s {
-                        ShadowMethod::NishitaNakamae if has_area_light(scene) => (exact_reference(), 1),
+                        s if s.exact_area_fraction() && has_area_light(scene) => (exact_reference(), 1),
                         _ => (&reference, 0),
                     };
                     let mut r = MethodResult::measured(v, s, status, &m, judge, |img, file| save(img, file))?;

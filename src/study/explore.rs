@@ -6,7 +6,7 @@
 //!
 //! | request | answer |
 //! | --- | --- |
-//! | `GET api/scene` | the scene: image size, lights, bounds, the stages |
+//! | `GET api/scene` | the scene: image size, lights, bounds, the stages and what each does |
 //! | `GET api/frame?shadows=S&width=W&height=H[&light=x,y,z]` | a render: times, counters, the stage's polygons on screen, the pixels where it differs from ray-cast |
 //! | `GET api/image?…` (the same parameters) | that render as PNG |
 //! | `GET api/trace?line=Y&…` | [`LineTrace`]: what `umbra trace --json` prints for line `Y` |
@@ -144,6 +144,8 @@ impl Explorer {
         let stages: Vec<&str> = ShadowMethod::ALL.iter().map(|m| m.name()).collect();
         let paper_stages: Vec<&str> =
             ShadowMethod::ALL.iter().filter(|m| m.has_paper_path()).map(|m| m.name()).collect();
+        let descriptions: serde_json::Map<String, Value> =
+            ShadowMethod::ALL.iter().map(|m| (m.name().to_string(), m.description().into())).collect();
         json!({
             "name": self.name,
             "width": cam.width,
@@ -155,6 +157,7 @@ impl Explorer {
             "stages": stages,
             "default_stage": ShadowMethod::DEFAULT.name(),
             "paper_stages": paper_stages,
+            "descriptions": descriptions,
             "paper": self.paper,
             "max_side": MAX_SIDE,
         })

@@ -47,34 +47,18 @@ pub fn frame(scene: &Scene, visibility: VisibilityMethod, shadows: ShadowMethod)
     render(scene, &opts).unwrap_or_else(|e| panic!("{e}")).frame
 }
 
-/// The exact scanline-family stages, with the settings that make them exact.
+/// Every exact stage but the reference, in each of its settings that a study tells apart
+/// (`ShadowMethod::variants`), named as on the command line: all of them from the engine's
+/// list, so that a new stage is checked against ray-cast as soon as it is registered. The
+/// stages that give area lights their exact fraction are judged by `tests/suite/area.rs`.
 pub fn exact_stages() -> Vec<(String, ShadowMethod)> {
-    use umbra::shadow::Counting;
-    use umbra::shadow::{AthertonWeilerGreenbergOptions, BouknightKelleyOptions, VolumeOptions};
-    let volumes = |counting| VolumeOptions { counting, ..VolumeOptions::default() };
-    let uncut = |counting| VolumeOptions { counting, sight_cuts: false, ..VolumeOptions::default() };
-    vec![
-        ("bouknight-kelley".into(), ShadowMethod::BouknightKelley(BouknightKelleyOptions::default())),
-        (
-            "bouknight-kelley --no-prefilter".into(),
-            ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false, ..Default::default() }),
-        ),
-        (
-            "bouknight-kelley --no-solid-cull".into(),
-            ShadowMethod::BouknightKelley(BouknightKelleyOptions { solid_cull: false, ..Default::default() }),
-        ),
-        ("bouknight-kelley --paper".into(), ShadowMethod::BouknightKelley(BouknightKelleyOptions::PAPER)),
-        ("atherton-weiler-greenberg".into(), ShadowMethod::AthertonWeilerGreenberg(Default::default())),
-        (
-            "atherton-weiler-greenberg --paper".into(),
-            ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions::PAPER),
-        ),
-        ("crow zpass".into(), ShadowMethod::Crow(volumes(Counting::ZPass))),
-        ("crow zfail".into(), ShadowMethod::Crow(volumes(Counting::ZFail))),
-        ("crow zpass --no-sight-cuts".into(), ShadowMethod::Crow(uncut(Counting::ZPass))),
-        ("stencil-volume zpass".into(), ShadowMethod::StencilVolume(volumes(Counting::ZPass))),
-        ("stencil-volume zfail".into(), ShadowMethod::StencilVolume(volumes(Counting::ZFail))),
-    ]
+    ShadowMethod::ALL
+        .iter()
+        .filter(|m| **m != ShadowMethod::RayCast && !m.exact_area_fraction())
+        .flat_map(ShadowMethod::variants)
+        .filter(ShadowMethod::is_exact)
+        .map(|m| (m.command_line(), m))
+        .collect()
 }
 
 /// Compares `got` with `reference` at every pixel by `differs(k)`; a pixel that differs is

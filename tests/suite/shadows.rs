@@ -919,3 +919,30 @@ fn the_exact_area_fraction_on_hand_cases_and_as_the_grids_limit() {
     }
     assert!(far > 0, "4×4 samples matched the exact fraction everywhere");
 }
+
+/// The registry: each stage once in `ShadowMethod::ALL`, by a name that parses back to it,
+/// described; its variants start with itself and are distinct; the default settings of
+/// every stage give each its default; and `exact_stages` holds every variant of every exact
+/// stage but the reference and those judged by the exact area fraction.
+#[test]
+fn every_registered_stage_is_named_described_configured_and_checked() {
+    use umbra::shadow::StageSettings;
+    let all = ShadowMethod::ALL;
+    let mut names: Vec<&str> = all.iter().map(|m| m.name()).collect();
+    names.sort_unstable();
+    names.dedup();
+    assert_eq!(names.len(), all.len(), "a name is registered twice");
+    let checked: Vec<ShadowMethod> = exact_stages().into_iter().map(|(_, m)| m).collect();
+    for m in &all {
+        assert_eq!(&m.name().parse::<ShadowMethod>().unwrap(), m);
+        assert!(m.description().len() > 40, "{m} is not described");
+        assert_eq!(&m.with_settings(&StageSettings::default()), m, "{m}");
+        let variants = m.variants();
+        assert_eq!(&variants[0], m);
+        for (i, v) in variants.iter().enumerate() {
+            assert!(!variants[i + 1..].contains(v), "{m}: variant {} twice", v.command_line());
+            let judged_by_ray_cast = v.is_exact() && *m != ShadowMethod::RayCast && !m.exact_area_fraction();
+            assert_eq!(checked.contains(v), judged_by_ray_cast, "{}", v.command_line());
+        }
+    }
+}

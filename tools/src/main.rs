@@ -12,7 +12,8 @@ use std::sync::atomic::{AtomicBool, AtomicIsize, Ordering::Relaxed};
 use std::sync::Arc;
 use umbra::shadow::Counting;
 use umbra::shadow::{
-    AthertonWeilerGreenbergOptions, BouknightKelleyOptions, Construction, ShadowFilter, VolumeOptions, WilliamsOptions,
+    AthertonWeilerGreenbergOptions, BouknightKelleyOptions, Construction, ShadowFilter, StageSettings, VolumeOptions,
+    WilliamsOptions,
 };
 use umbra::study::compare::{compare, CompareOptions};
 use umbra::study::scale::{scale, ScaleOptions, Sweep};
@@ -340,22 +341,18 @@ impl ShadowArgs {
             FilterArg::SoftEdge => ShadowFilter::SoftEdge(kernel),
         };
         let construction = if self.no_silhouettes { Construction::PerPolygon } else { self.volumes };
-        let volumes = VolumeOptions { counting: self.crow_count, construction, sight_cuts: !self.no_sight_cuts };
-        match method {
-            ShadowMethod::BouknightKelley(_) => ShadowMethod::BouknightKelley(BouknightKelleyOptions {
+        let settings = StageSettings {
+            bouknight_kelley: BouknightKelleyOptions {
                 prefilter: !self.no_prefilter,
                 sphere_grid: !self.no_sphere_grid,
                 seen_receivers: !self.all_receivers,
                 drop_behind: !self.no_drop_behind,
                 wedge: !self.no_wedge,
                 solid_cull: !self.no_solid_cull,
-            }),
-            ShadowMethod::AthertonWeilerGreenberg(_) => {
-                ShadowMethod::AthertonWeilerGreenberg(self.awg.options(!self.no_solid_cull))
-            }
-            ShadowMethod::Crow(_) => ShadowMethod::Crow(volumes),
-            ShadowMethod::StencilVolume(_) => ShadowMethod::StencilVolume(volumes),
-            ShadowMethod::Williams(_) => ShadowMethod::Williams(WilliamsOptions {
+            },
+            atherton_weiler_greenberg: self.awg.options(!self.no_solid_cull),
+            volumes: VolumeOptions { counting: self.crow_count, construction, sight_cuts: !self.no_sight_cuts },
+            williams: WilliamsOptions {
                 map_size: self.map_size,
                 bias: self.bias,
                 slope_bias: self.slope_bias,
@@ -364,9 +361,9 @@ impl ShadowArgs {
                 filter,
                 cull_front: self.cull_front,
                 fit_to_view: !self.no_fit,
-            }),
-            other => other,
-        }
+            },
+        };
+        method.with_settings(&settings)
     }
 
     /// Every method of `methods` configured by these flags; with `--paper`, each stage that
@@ -738,17 +735,11 @@ fn run(cli: Cli) -> umbra::Result<()> {
 /// `umbra render`: one frame, its analysis buffers and its stats.
 fn render_command(a: RenderArgs) -> umbra::Result<()> {
     check_png_name(&a.output)?;
-    let drawn = matches!(
-        a.shadows,
-        ShadowMethod::BouknightKelley(_)
-            | ShadowMethod::AthertonWeilerGreenberg(_)
-            | ShadowMethod::Crow(_)
-            | ShadowMethod::Planar
-    );
-    if a.debug.is_some() && !drawn {
+    if a.debug.is_some() && !a.shadows.has_outlines() {
+        let drawn: Vec<&str> = ShadowMethod::ALL.iter().filter(|m| m.has_outlines()).map(|m| m.name()).collect();
         return Err(Error::InvalidOption(format!(
-            "--debug shadow-polygons draws the polygons of bouknight-kelley, atherton-weiler-greenberg, crow \
-             and planar; {} has none to draw",
+            "--debug shadow-polygons draws the polygons of {}; {} has none to draw",
+            drawn.join(", "),
             a.shadows
         )));
     }

@@ -6,41 +6,6 @@
 const $ = (id) => document.getElementById(id);
 const STATIC = window.UMBRA_STATIC || null;
 
-const INTRO = {
-  "none": "No shadows: every light sample reaches every point on its seen side.",
-  "ray-cast": "The reference: one shadow ray per pixel and light sample, through a BVH.",
-  "bouknight-kelley":
-    "Appel / Bouknight-Kelley (1970): every polygon's shadow projected from the light onto each " +
-    "receiver's plane (pairs kept by the sphere prefilter). For each run, the shadow polygons on " +
-    "its receiver are walked with their own active edges; then a segment no shadow polygon touches " +
-    "is lit, one a shadow polygon covers fully is in shadow, and one covered partly is split at " +
-    "that polygon's edges and each part examined again. Below: the segments of the picked run, " +
-    "one row per depth of the recursion.",
-  "crow":
-    "Crow (1977): shadow volumes bounded by shadow polygons. Along the run, each shadow polygon " +
-    "in front of the visible point adds +1 (entering a volume) or -1 (leaving one); near caps " +
-    "carry the eye's own count. Where the count is 0 the point is lit. Below: each polygon's " +
-    "contribution over the pixels where it holds, and the count along the run.",
-  "atherton-weiler-greenberg":
-    "Atherton, Weiler & Greenberg (1978): hidden-surface removal from the light (Weiler-Atherton " +
-    "clipping) leaves the lit parts of every polygon as detail polygons, merged into the model. " +
-    "A pixel is lit where a lit detail polygon of its polygon covers it. Below: the detail " +
-    "polygons over the picked run.",
-  "williams":
-    "Williams (1978): a depth map rendered from the light; a point is lit where it is no farther " +
-    "from the light than the map's depth at its texel (with bias and percentage-closer filtering). " +
-    "Approximate: the red pixels differ from ray-cast.",
-  "stencil-volume":
-    "Shadow volumes counted per pixel in a stencil buffer (Heidmann 1991): the z-buffer version " +
-    "of Crow's count, rasterised before the frame is shaded.",
-  "planar":
-    "Blinn (1988): shadows projected onto marked receiver planes. Approximate.",
-  "nishita-nakamae":
-    "Nishita & Nakamae (1983-85): umbra and penumbra polygons from the light's corners; pixels " +
-    "in an umbra are dark and outside every penumbra lit, a span at a time; only in the penumbra " +
-    "is the visible part of an area light clipped out and measured: its exact lit fraction.",
-};
-
 const state = {
   scene: null, stage: "", paper: false, width: 0, height: 0, light: null,
   line: 0, x: null, frame: null, trace: null, playing: null, token: 0, scale: 1,
@@ -388,7 +353,7 @@ function drawStage(t) {
   const panel = $("stage-panel");
   panel.dataset.stage = state.stage;
   $("stage-title").textContent = `Shadow stage: ${t.shadows}`;
-  $("stage-intro").textContent = INTRO[state.stage] || "";
+  $("stage-intro").textContent = state.scene.descriptions[state.stage] || "";
   const d = pickedDecision(t);
   $("stage-map-box").hidden = true;
   const c = $("stage-canvas");
