@@ -24,7 +24,7 @@ fn group<'a>(c: &'a mut Criterion, name: &str) -> criterion::BenchmarkGroup<'a, 
 
 fn stages(c: &mut Criterion) {
     let scenes: Vec<(&str, Scene)> = vec![
-        ("cubes10", generate::cubes(10, true, W, H).unwrap()),
+        ("cubes10", generate::cubes(10, generate::Faces::Triangles, W, H).unwrap()),
         ("sphere10k", generate::spheres(10_000, 1, W, H).unwrap()),
         ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap()),
         ("quads16", generate::stacked_quads(16, W, H).unwrap()),
@@ -45,7 +45,7 @@ fn stages(c: &mut Criterion) {
         for m in methods {
             let o = opts(m);
             match render(scene, &o) {
-                Err(umbra::Error::NotApplicable(_)) => continue,
+                Err(umbra::Error::NotApplicable { .. }) => continue,
                 r => drop(r.unwrap()),
             }
             let label = o.shadows.command_line().replace(' ', "");
@@ -58,7 +58,7 @@ fn stages(c: &mut Criterion) {
 fn atherton_weiler_greenberg(c: &mut Criterion) {
     let mut g = group(c, "awg");
     for (name, scene) in [
-        ("cubes10", generate::cubes(10, true, W, H).unwrap()),
+        ("cubes10", generate::cubes(10, generate::Faces::Triangles, W, H).unwrap()),
         ("sphere10k", generate::spheres(10_000, 1, W, H).unwrap()),
     ] {
         g.bench_function(BenchmarkId::new("pass1", name), |b| {
@@ -92,7 +92,7 @@ fn atherton_weiler_greenberg(c: &mut Criterion) {
 fn planar(c: &mut Criterion) {
     let mut g = group(c, "planar");
     for (name, mut scene) in [
-        ("cubes10", generate::cubes(10, true, W, H).unwrap()),
+        ("cubes10", generate::cubes(10, generate::Faces::Triangles, W, H).unwrap()),
         ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap()),
     ] {
         scene.set_receiver(0, true).unwrap();
@@ -107,7 +107,7 @@ fn planar(c: &mut Criterion) {
 fn williams(c: &mut Criterion) {
     let mut g = group(c, "williams");
     for (name, scene) in [
-        ("cubes10", generate::cubes(10, true, W, H).unwrap()),
+        ("cubes10", generate::cubes(10, generate::Faces::Triangles, W, H).unwrap()),
         ("sphere100k", generate::spheres(100_000, 1, W, H).unwrap()),
     ] {
         let nearest = WilliamsOptions { filter: ShadowFilter::Nearest, ..Default::default() };

@@ -13,7 +13,7 @@ const W: u32 = 1920;
 const H: u32 = 1080;
 
 fn scenes() -> Vec<(String, Scene)> {
-    let mut v = vec![("cubes10".to_string(), generate::cubes(10, true, W, H).unwrap())];
+    let mut v = vec![("cubes10".to_string(), generate::cubes(10, generate::Faces::Triangles, W, H).unwrap())];
     for d in [1, 4, 16, 64] {
         v.push((format!("quads{d}"), generate::stacked_quads(d, W, H).unwrap()));
     }

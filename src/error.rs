@@ -90,8 +90,39 @@ pub enum Error {
         /// The encoder's reason.
         source: Box<dyn std::error::Error + Send + Sync>,
     },
-    /// A request that the engine cannot carry out: an unknown method name, an option or a
-    /// scene built by the API with values out of range.
+    /// A name the engine does not know (a method, a counter): what kind of name, the name,
+    /// and every name it knows.
+    #[error("unknown {kind} '{name}' (known: {})", .known.join(", "))]
+    UnknownName {
+        /// What kind of name ("shadow method", "counter").
+        kind: String,
+        /// The name as given.
+        name: String,
+        /// The names the engine knows.
+        known: Vec<String>,
+    },
+    /// A setting outside what the engine accepts: which, the value as given, and what it
+    /// must be.
+    #[error("{setting} {value} is not {allowed}")]
+    OutOfRange {
+        /// The setting ("gamma", "williams: map size").
+        setting: String,
+        /// Its value, as written.
+        value: String,
+        /// What it must be ("in 0.1..=10").
+        allowed: String,
+    },
+    /// A scene built in code that the loader would refuse: the part that is wrong ("camera",
+    /// "light 2", "material 'red'", "object 3") and what is wrong with it.
+    #[error("{part}: {problem}")]
+    InvalidScene {
+        /// The part of the scene.
+        part: String,
+        /// What is wrong, one line.
+        problem: String,
+    },
+    /// A request that the engine cannot carry out and that no other variant describes (a
+    /// file the command line will not overwrite, a malformed request to explore's page).
     #[error("{0}")]
     InvalidOption(String),
     /// Work that would need more memory than the engine's budget (`budget`, bytes): nothing
@@ -105,9 +136,15 @@ pub enum Error {
         /// The budget.
         budget: u64,
     },
-    /// A method that does not apply to this scene (planar shadows with no receiver).
-    #[error("{0}")]
-    NotApplicable(String),
+    /// A method that does not apply to this scene: the stage, and what it needs that the
+    /// scene lacks (planar shadows with no receiver).
+    #[error("{stage}: {why}")]
+    NotApplicable {
+        /// The stage's name.
+        stage: String,
+        /// Why it does not apply, one line.
+        why: String,
+    },
     /// A stage failed where it should not have: a defect in umbra, not in the input.
     #[error("internal error (a defect in umbra; please report it): {0}")]
     Internal(String),
@@ -122,6 +159,20 @@ impl Error {
     /// An input error at `loc`.
     pub fn input(loc: FileLoc, message: impl Into<String>) -> Self {
         Error::Load { loc, message: message.into() }
+    }
+
+    /// A setting out of range (see [`Error::OutOfRange`]).
+    pub(crate) fn out_of_range(
+        setting: impl Into<String>,
+        value: impl fmt::Display,
+        allowed: impl Into<String>,
+    ) -> Self {
+        Error::OutOfRange { setting: setting.into(), value: value.to_string(), allowed: allowed.into() }
+    }
+
+    /// A scene part that is wrong (see [`Error::InvalidScene`]).
+    pub(crate) fn scene(part: impl Into<String>, problem: impl Into<String>) -> Self {
+        Error::InvalidScene { part: part.into(), problem: problem.into() }
     }
 }
 
@@ -147,9 +198,10 @@ pub(crate) fn parse_named<'a, T>(
     name: impl Fn(&T) -> &'static str,
     what: &str,
 ) -> Result<&'a T> {
-    all.iter().find(|m| name(m) == s).ok_or_else(|| {
-        let known: Vec<&str> = all.iter().map(name).collect();
-        Error::InvalidOption(format!("unknown {what} '{s}' (known: {})", known.join(", ")))
+    all.iter().find(|m| name(m) == s).ok_or_else(|| Error::UnknownName {
+        kind: what.into(),
+        name: s.into(),
+        known: all.iter().map(|m| name(m).to_string()).collect(),
     })
 }
 

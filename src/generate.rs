@@ -73,9 +73,28 @@ fn check_size(family: &str, polygons: u64, corners: u64) -> Result<()> {
     crate::budget::check(format_args!("generate {family}: {polygons} polygons"), bytes)
 }
 
-/// A floor with an `n`×`n` grid of unit cubes (each as 12 triangles when `triangles`, else
-/// 6 quads) under a point light: 10×10 gives 1,201 polygons as triangles.
-pub fn cubes(n: u32, triangles: bool, width: u32, height: u32) -> Result<Scene> {
+/// How a generated box's faces are made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Faces {
+    /// Six quads.
+    Quads,
+    /// Twelve triangles.
+    Triangles,
+}
+
+/// Where [`scattered`] puts its triangles in the cube.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Placement {
+    /// Uniformly.
+    Uniform,
+    /// Clustered around the centre (a rough normal distribution).
+    Clustered,
+}
+
+/// A floor with an `n`×`n` grid of unit cubes, their `faces` quads or triangles, under a
+/// point light: 10×10 gives 1,201 polygons as triangles.
+pub fn cubes(n: u32, faces: Faces, width: u32, height: u32) -> Result<Scene> {
+    let triangles = faces == Faces::Triangles;
     check_size("cubes", crate::budget::mul(n as u64 * n as u64, if triangles { 12 } else { 6 }), 4)?;
     let half = n as f64 + 1.0;
     let mut boxes = Mesh::default();
@@ -479,9 +498,10 @@ fn random_light(rng: &mut ChaCha8Rng, clear: &dyn Fn(DVec3) -> bool) -> LightKin
 }
 
 /// `n` random triangles with edges about `size` long, scattered through a cube of side 4 —
-/// uniformly, or clustered around its centre — over a floor, for Slater et al.'s study of
-/// polygon count, size and distribution.
-pub fn scattered(n: u32, size: f64, clustered: bool, width: u32, height: u32) -> Result<Scene> {
+/// uniformly, or clustered around its centre (`placement`) — over a floor, for Slater et
+/// al.'s study of polygon count, size and distribution.
+pub fn scattered(n: u32, size: f64, placement: Placement, width: u32, height: u32) -> Result<Scene> {
+    let clustered = placement == Placement::Clustered;
     check_size("scattered triangles", n as u64, 3)?;
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mut tris = Vec::with_capacity(n as usize);

@@ -32,7 +32,7 @@
 //! ```
 //! use umbra::{generate, render, RenderOptions, ShadowMethod, VisibilityMethod};
 //!
-//! let scene = generate::cubes(2, false, 64, 48)?;
+//! let scene = generate::cubes(2, generate::Faces::Quads, 64, 48)?;
 //! let opts = RenderOptions {
 //!     visibility: VisibilityMethod::Scanline,
 //!     shadows: ShadowMethod::RayCast,

@@ -19,6 +19,7 @@ use crate::frame::BACKGROUND;
 use crate::scene::{LightSample, Scene};
 use crate::shadow::blocked;
 use crate::view::View;
+use glam::DVec2;
 
 /// How far (in pixels) a sample point moves to test for a tie.
 pub const TIE_DELTA: f64 = 1e-6;
@@ -59,7 +60,7 @@ impl<'a> Reference<'a> {
     /// Builds the two ray-casting structures (every polygon; the shadow casters).
     ///
     /// ```
-    /// let scene = umbra::generate::cubes(1, false, 32, 24)?;
+    /// let scene = umbra::generate::cubes(1, umbra::generate::Faces::Quads, 32, 24)?;
     /// let oracle = umbra::reference::Reference::new(&scene);
     /// let centre = oracle.at(16.5, 12.5);
     /// assert_eq!(centre.lit.len(), scene.lights().len());
@@ -205,6 +206,37 @@ pub fn exact_fraction(scene: &Scene, light: usize, p: glam::DVec3, poly: usize) 
     fraction_among(scene, &View::new(&scene.camera), light, p, poly, casters)
 }
 
+/// What a point sees of an area light, in the light's own coordinates: the light is the unit
+/// square of `(a, b)` (`corner + a·edge_u + b·edge_v`), as [`exact_fraction`] takes it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightView {
+    /// The part of the light the plane of the point's polygon cuts away (on the side the eye
+    /// does not see); empty when none.
+    pub cut: Vec<DVec2>,
+    /// Each casting polygon's shadow from the point on the light's plane: the polygon, and
+    /// its projection (it may reach beyond the square).
+    pub hidden: Vec<(usize, Vec<DVec2>)>,
+    /// What is left of the square: the visible part, as rings (a hole wound the other way).
+    pub visible: Vec<Vec<DVec2>>,
+    /// Its area: the exact lit fraction.
+    pub fraction: f64,
+}
+
+impl Reference<'_> {
+    /// What the point seen at image point `(x, y)` sees of area light `light`, and its exact
+    /// fraction, step by step as [`exact_fraction`] finds it (`umbra explore` draws it for a
+    /// picked pixel). `None` when nothing is seen there or the light is not an area light.
+    pub fn light_view_at(&self, light: usize, x: f64, y: f64) -> Option<LightView> {
+        let (poly, p) = self.visible(x, y)?;
+        let area = crate::shadow::AreaLight::of(self.scene, light)?;
+        let (lo, hi) = area.vertices().iter().fold((p, p), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+        let mut near = Vec::new();
+        self.casters.overlapping(lo, hi, |i| near.push(i as usize));
+        near.sort_unstable();
+        view_among(self.scene, &self.view, light, p, poly, near.into_iter(), true)
+    }
+}
+
 /// [`exact_fraction`] with the casters among `casters` (a superset of those that can cross
 /// a segment from `p` to the light).
 fn fraction_among(
@@ -215,30 +247,54 @@ fn fraction_among(
     poly: usize,
     casters: impl Iterator<Item = usize>,
 ) -> Option<f64> {
+    Some(view_among(scene, view, light, p, poly, casters, false)?.fraction)
+}
+
+/// The steps of [`exact_fraction`], keeping the cut and the shadows when `keep`.
+fn view_among(
+    scene: &Scene,
+    view: &View,
+    light: usize,
+    p: glam::DVec3,
+    poly: usize,
+    casters: impl Iterator<Item = usize>,
+    keep: bool,
+) -> Option<LightView> {
     use crate::geometry::weiler_atherton::{clip, Region};
     let area = crate::shadow::AreaLight::of(scene, light)?;
     let polygon = scene.polygons.get(poly)?;
+    let mut out = LightView { cut: Vec::new(), hidden: Vec::new(), visible: Vec::new(), fraction: 0.0 };
     let seen = polygon.plane.distance(view.eye).signum();
     if seen == 0.0 {
-        return Some(0.0);
+        return Some(out);
     }
     // Step 1: the unit square cut by the plane of `poly`, to the side the eye sees.
-    let square = Region::from_ring(vec![glam::DVec2::ZERO, glam::DVec2::X, glam::DVec2::ONE, glam::DVec2::Y]);
-    let mut cut = Vec::new();
-    area.cut_away(&polygon.plane, seen, &mut cut);
-    let mut region = if cut.is_empty() { square } else { clip(&square, &Region::from_ring(cut)).ok()?.outside };
+    let square = Region::from_ring(vec![DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y]);
+    area.cut_away(&polygon.plane, seen, &mut out.cut);
+    let mut region =
+        if out.cut.is_empty() { square } else { clip(&square, &Region::from_ring(out.cut.clone())).ok()?.outside };
     // Step 2: each other face's casting polygons' shadows from P on the light, subtracted.
     let target = area.target_from(p);
     let mut proj = crate::shadow::Projector::default();
     for i in casters.filter(|&i| scene.polygons[i].face != polygon.face) {
-        if region.rings.is_empty() {
-            return Some(0.0);
+        if region.rings.is_empty() && !keep {
+            return Some(out);
         }
         if proj.project(scene.verts(i), &target) {
-            region = clip(&region, &Region::from_ring(area.shadow_ab(&proj))).ok()?.outside;
+            let shadow = area.shadow_ab(&proj);
+            if !region.rings.is_empty() {
+                region = clip(&region, &Region::from_ring(shadow.clone())).ok()?.outside;
+            }
+            if keep {
+                out.hidden.push((i, shadow));
+            }
         }
     }
-    Some(region.area().abs().min(1.0))
+    out.fraction = region.area().abs().min(1.0);
+    if keep {
+        out.visible = region.rings;
+    }
+    Some(out)
 }
 
 /// The reference for planar mirrors: for each pixel whose visible polygon is a mirror seen from the front, the

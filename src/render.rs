@@ -132,7 +132,7 @@ fn check_frame_memory(scene: &Scene, opts: &RenderOptions) -> Result<()> {
 /// ```
 /// use umbra::{generate, RenderOptions, Renderer};
 ///
-/// let scene = generate::cubes(2, false, 64, 48)?;
+/// let scene = generate::cubes(2, generate::Faces::Quads, 64, 48)?;
 /// let mut renderer = Renderer::new();
 /// for _ in 0..3 {
 ///     let out = renderer.render(&scene, &RenderOptions::default())?;
@@ -170,7 +170,7 @@ impl Renderer {
     ///
     /// ```
     /// use umbra::{generate, RenderOptions, Renderer};
-    /// let scene = generate::cubes(1, false, 64, 48)?;
+    /// let scene = generate::cubes(1, generate::Faces::Quads, 64, 48)?;
     /// let mut renderer = Renderer::new();
     /// renderer.render(&scene, &RenderOptions { shadows: "williams".parse()?, ..Default::default() })?;
     /// assert!(renderer.kept_bytes() > 1 << 20); // a 2048² map
@@ -217,7 +217,7 @@ impl Renderer {
     /// let lines = Arc::new(AtomicU64::new(0));
     /// let seen = lines.clone();
     /// let mut renderer = Renderer::new().with_progress(move |p| seen.store(p.done, Ordering::Relaxed));
-    /// renderer.render(&generate::cubes(2, false, 64, 48)?, &RenderOptions::default())?;
+    /// renderer.render(&generate::cubes(2, generate::Faces::Quads, 64, 48)?, &RenderOptions::default())?;
     /// assert_eq!(lines.load(Ordering::Relaxed), 48);
     /// # Ok::<(), umbra::Error>(())
     /// ```

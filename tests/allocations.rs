@@ -48,7 +48,7 @@ static ALLOCATOR: Counting = Counting;
 #[test]
 fn a_renderer_allocates_no_frame_sized_buffer_after_its_first_frame() {
     let (w, h) = (320u32, 240u32);
-    let mut scene = generate::cubes(4, false, w, h).unwrap();
+    let mut scene = generate::cubes(4, generate::Faces::Quads, w, h).unwrap();
     // Blinn's planar shadows need a receiver: the floor.
     assert!(!scene.mark_planar_receivers().is_empty());
     LARGE.store((w * h) as usize, Ordering::Relaxed);

@@ -15,7 +15,7 @@ pub const BACKGROUND: u32 = u32::MAX;
 /// ```
 /// use umbra::{generate, render, RenderOptions, BACKGROUND};
 ///
-/// let out = render(&generate::cubes(2, false, 64, 48)?, &RenderOptions::default())?;
+/// let out = render(&generate::cubes(2, generate::Faces::Quads, 64, 48)?, &RenderOptions::default())?;
 /// let f = &out.frame;
 /// let k = (24 * f.width + 32) as usize; // the pixel at (32, 24)
 /// assert_ne!(f.id[k], BACKGROUND); // the face seen there (the floor or a cube)
@@ -334,11 +334,11 @@ pub fn check_gamma(gamma: f32) -> Result<()> {
     if GAMMA_RANGE.contains(&gamma) {
         Ok(())
     } else {
-        Err(Error::InvalidOption(format!(
-            "gamma {gamma} is not in {}..={} (2.2 is the usual display gamma)",
-            GAMMA_RANGE.start(),
-            GAMMA_RANGE.end()
-        )))
+        Err(Error::out_of_range(
+            "gamma",
+            gamma,
+            format!("in {}..={} (2.2 is the usual display gamma)", GAMMA_RANGE.start(), GAMMA_RANGE.end()),
+        ))
     }
 }
 

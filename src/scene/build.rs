@@ -149,13 +149,13 @@ impl SceneBuilder {
         let mut objects = Vec::with_capacity(self.objects.len());
         for (i, (mut o, name)) in self.objects.into_iter().enumerate() {
             o.material = self.materials.iter().position(|m| m.name == name).ok_or_else(|| {
-                Error::InvalidOption(format!("object {i}: no material named '{name}' (add it with .material())"))
+                Error::scene(format!("object {i}"), format!("no material named '{name}' (add it with .material())"))
             })?;
             objects.push(o);
         }
         for (i, m) in self.materials.iter().enumerate() {
             if self.materials[..i].iter().any(|n| n.name == m.name) {
-                return Err(Error::InvalidOption(format!("material '{}' is added twice", m.name)));
+                return Err(Error::scene(format!("material '{}'", m.name), "is added twice"));
             }
         }
         Scene::new(self.camera, self.render, self.materials, self.lights, objects)

@@ -286,7 +286,7 @@ impl Scene {
         let objects =
             raw.object.into_iter().map(|o| object(&cx, o, &by_name, dir, &mut meshes)).collect::<Result<Vec<_>>>()?;
         Scene::new(camera, render, materials, lights, objects).map_err(|e| match e {
-            Error::InvalidOption(m) => Error::input(FileLoc::file(file), m),
+            Error::InvalidScene { part, problem } => Error::input(FileLoc::file(file), format!("{part}: {problem}")),
             e => e,
         })
     }

@@ -599,19 +599,19 @@ impl Scene {
         lights: Vec<Light>,
         objects: Vec<Object>,
     ) -> Result<Scene> {
-        camera.validate().map_err(Error::InvalidOption)?;
+        camera.validate().map_err(|m| Error::scene("camera", m))?;
         for (i, l) in lights.iter().enumerate() {
-            l.validate().map_err(|m| Error::InvalidOption(format!("light {i}: {m}")))?;
+            l.validate().map_err(|m| Error::scene(format!("light {i}"), m))?;
         }
         if materials.is_empty() {
             materials.push(Material::new("default"));
         }
         for m in &materials {
-            m.validate().map_err(|e| Error::InvalidOption(format!("material '{}': {e}", m.name)))?;
+            m.validate().map_err(|e| Error::scene(format!("material '{}'", m.name), e))?;
         }
         for (i, o) in objects.iter().enumerate() {
             if o.material >= materials.len() {
-                return Err(Error::InvalidOption(format!("object {i}: material index {} out of range", o.material)));
+                return Err(Error::scene(format!("object {i}"), format!("material index {} out of range", o.material)));
             }
             let m = &o.mesh;
             let bad = m.faces.iter().any(|f| {
@@ -620,12 +620,12 @@ impl Scene {
                     || (!f.normals.is_empty() && f.normals.len() != f.vertices.len())
             });
             if bad {
-                return Err(Error::InvalidOption(format!("object {i}: face index out of range")));
+                return Err(Error::scene(format!("object {i}"), "face index out of range"));
             }
             let finite = m.positions.iter().chain(&m.normals).all(|p| p.is_finite());
             let t = &o.transform;
             if !(finite && t.scale.is_finite() && t.rotate.is_finite() && t.translate.is_finite()) {
-                return Err(Error::InvalidOption(format!("object {i}: non-finite coordinate")));
+                return Err(Error::scene(format!("object {i}"), "non-finite coordinate"));
             }
         }
         let mut scene = Scene {
@@ -736,7 +736,7 @@ impl Scene {
     /// it was).
     ///
     /// ```
-    /// let mut scene = umbra::generate::cubes(1, false, 64, 48)?;
+    /// let mut scene = umbra::generate::cubes(1, umbra::generate::Faces::Quads, 64, 48)?;
     /// let mut camera = scene.camera().clone();
     /// camera.width = 32;
     /// scene.set_camera(camera.clone())?;
@@ -746,7 +746,7 @@ impl Scene {
     /// # Ok::<(), umbra::Error>(())
     /// ```
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
-        camera.validate().map_err(Error::InvalidOption)?;
+        camera.validate().map_err(|m| Error::scene("camera", m))?;
         self.camera = camera;
         Ok(())
     }
@@ -768,10 +768,10 @@ impl Scene {
             materials.push(Material::new("default"));
         }
         for m in &materials {
-            m.validate().map_err(|e| Error::InvalidOption(format!("material '{}': {e}", m.name)))?;
+            m.validate().map_err(|e| Error::scene(format!("material '{}'", m.name), e))?;
         }
         if let Some((i, o)) = self.objects.iter().enumerate().find(|(_, o)| o.material >= materials.len()) {
-            return Err(Error::InvalidOption(format!("object {i}: material index {} out of range", o.material)));
+            return Err(Error::scene(format!("object {i}"), format!("material index {} out of range", o.material)));
         }
         self.materials = materials;
         Ok(())
@@ -785,7 +785,7 @@ impl Scene {
     /// Replaces the lights, after the checks the loader makes.
     pub fn set_lights(&mut self, lights: Vec<Light>) -> Result<()> {
         for (i, l) in lights.iter().enumerate() {
-            l.validate().map_err(|m| Error::InvalidOption(format!("light {i}: {m}")))?;
+            l.validate().map_err(|m| Error::scene(format!("light {i}"), m))?;
         }
         self.lights = lights;
         Ok(())
@@ -802,7 +802,7 @@ impl Scene {
         let o = self
             .objects
             .get_mut(object)
-            .ok_or_else(|| Error::InvalidOption(format!("no object {object} (the scene has {count})")))?;
+            .ok_or_else(|| Error::out_of_range("object", object, format!("an object of the scene (it has {count})")))?;
         o.receiver = receiver;
         Ok(())
     }
@@ -956,7 +956,7 @@ impl Scene {
 mod tests {
     #[test]
     fn the_flat_ground_is_the_planar_receiver_and_no_cube_is() {
-        let mut scene = crate::generate::cubes(3, false, 64, 48).unwrap();
+        let mut scene = crate::generate::cubes(3, crate::generate::Faces::Quads, 64, 48).unwrap();
         assert!(scene.objects().iter().all(|o| !o.receiver));
         let chosen = scene.mark_planar_receivers();
         assert_eq!(chosen.len(), 1);

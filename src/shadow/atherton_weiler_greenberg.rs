@@ -1195,10 +1195,11 @@ impl ShadowDatabase {
         counters: &mut Counters,
     ) -> Result<ShadowDatabase> {
         let l = scene.lights.get(light).ok_or_else(|| {
-            Error::InvalidOption(format!(
-                "no light {light}: the scene has {} light(s), numbered from 0",
-                scene.lights.len()
-            ))
+            Error::out_of_range(
+                "light",
+                light,
+                format!("a light of the scene (it has {}, numbered from 0)", scene.lights.len()),
+            )
         })?;
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
         let t = Instant::now();

@@ -514,7 +514,7 @@ pub struct CountAdd {
 /// use umbra::shadow::{Counting, VolumeOptions, WilliamsOptions};
 /// use umbra::{generate, render, RenderOptions, ShadowMethod};
 ///
-/// let scene = generate::cubes(2, false, 64, 48)?;
+/// let scene = generate::cubes(2, generate::Faces::Quads, 64, 48)?;
 /// let z_fail = ShadowMethod::Crow(VolumeOptions { counting: Counting::ZFail, ..Default::default() });
 /// let small_map = ShadowMethod::Williams(WilliamsOptions { map_size: 512, ..Default::default() });
 /// for shadows in [z_fail, small_map, "bouknight-kelley".parse()?] {

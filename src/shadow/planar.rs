@@ -76,11 +76,12 @@ impl<'a> Planar<'a> {
         let receivers: Vec<usize> =
             (0..scene.polygons.len()).filter(|&i| scene.objects[scene.polygons[i].object as usize].receiver).collect();
         if receivers.is_empty() {
-            return Err(Error::NotApplicable(
-                "planar shadows need a receiver: mark the ground's object with receiver = true, or name it \
-                 on the command line (--receiver NAME, or --receiver auto for every large flat object)"
+            return Err(Error::NotApplicable {
+                stage: "planar".into(),
+                why: "planar shadows need a receiver: mark the ground's object with receiver = true, or name it \
+                      on the command line (--receiver NAME, or --receiver auto for every large flat object)"
                     .into(),
-            ));
+            });
         }
         counters.add("receivers", receivers.len() as u64);
         let mut shadows = Vec::new();

@@ -100,10 +100,7 @@ impl SoftEdges {
     /// Refuses a spacing that is not a finite number from 0.25 to 64.
     pub(crate) fn check(&self) -> Result<()> {
         if !(0.25..=64.0).contains(&self.spacing) {
-            return Err(crate::Error::InvalidOption(format!(
-                "soft edges: tap spacing {} is not from 0.25 to 64 pixels",
-                self.spacing
-            )));
+            return Err(crate::Error::out_of_range("soft edges: tap spacing", self.spacing, "from 0.25 to 64 pixels"));
         }
         Ok(())
     }

@@ -150,23 +150,25 @@ impl WilliamsOptions {
     /// [`Self::MAX_MAP_SIZE`] texels, an odd kernel side of 1 to [`Self::MAX_KERNEL`] and no
     /// wider than the map, and biases that are finite and not negative.
     pub fn check(&self) -> Result<()> {
-        let fail = |what: String| Err(Error::InvalidOption(format!("williams: {what}")));
+        let fail = |setting: &str, value: &dyn std::fmt::Display, allowed: String| {
+            Err(Error::out_of_range(format!("williams: {setting}"), value, allowed))
+        };
         if !(1..=Self::MAX_MAP_SIZE).contains(&self.map_size) {
-            return fail(format!("map size {} is not in 1..={}", self.map_size, Self::MAX_MAP_SIZE));
+            return fail("map size", &self.map_size, format!("in 1..={}", Self::MAX_MAP_SIZE));
         }
         if let ShadowFilter::Pcf(n) | ShadowFilter::SoftEdge(n) | ShadowFilter::Stochastic(n) = self.filter {
             if n.is_multiple_of(2) || n > Self::MAX_KERNEL {
-                return fail(format!("kernel size {n} is not odd and in 1..={}", Self::MAX_KERNEL));
+                return fail("kernel size", &n, format!("odd and in 1..={}", Self::MAX_KERNEL));
             }
             if n > self.map_size {
-                return fail(format!("kernel size {n} is wider than the {0}x{0} map", self.map_size));
+                return fail("kernel size", &n, format!("within the {0}x{0} map", self.map_size));
             }
         }
         for (name, v) in
             [("bias", self.bias.unwrap_or(0.0)), ("slope bias", self.slope_bias), ("normal offset", self.normal_offset)]
         {
             if !(v.is_finite() && v >= 0.0) {
-                return fail(format!("{name} {v} is not a finite number ≥ 0"));
+                return fail(name, &v, "a finite number ≥ 0".into());
             }
         }
         Ok(())

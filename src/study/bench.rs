@@ -217,7 +217,7 @@ impl Timing {
 /// told each row as it starts.
 pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<Vec<BenchRow>> {
     if o.runs == 0 {
-        return Err(Error::InvalidOption("bench needs at least one timed run".into()));
+        return Err(Error::out_of_range("bench: timed runs", 0, "at least 1"));
     }
     let pools = pools(&o.threads)?;
     let mut rows = Vec::new();
@@ -277,7 +277,7 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
 /// A pool per thread count, or one of the caller's size where none is given.
 fn pools(threads: &[usize]) -> Result<Vec<rayon::ThreadPool>> {
     if threads.contains(&0) {
-        return Err(Error::InvalidOption("bench cannot render with 0 threads".into()));
+        return Err(Error::out_of_range("bench: threads", 0, "at least 1"));
     }
     let counts = if threads.is_empty() { vec![rayon::current_num_threads()] } else { threads.to_vec() };
     counts

@@ -221,7 +221,7 @@ pub fn compare(
             let ropts = RenderOptions { visibility: v, shadows: s.clone(), ..RenderOptions::default() };
             let (status, measured) = match measure(scene, &ropts, opts.warmup, opts.runs) {
                 Ok(m) => ("ok".to_string(), Some(m)),
-                Err(Error::NotApplicable(why)) => (format!("not applicable: {why}"), None),
+                Err(Error::NotApplicable { why, .. }) => (format!("not applicable: {why}"), None),
                 Err(e @ Error::Internal(_)) => (format!("failed: {e}"), None),
                 Err(e) => return Err(e),
             };

@@ -11,6 +11,7 @@
 //! | `GET api/image?…` (the same parameters) | that render as PNG |
 //! | `GET api/trace?line=Y&…` | [`LineTrace`]: what `umbra trace --json` prints for line `Y` |
 //! | `GET api/picture?index=K&…` | picture `K` of the frame's `pictures` (Williams: a shadow map) as PNG |
+//! | `GET api/light?x=X&line=Y&…` | what the point seen at pixel `(X, Y)` sees of the first area light: the light as the unit square of its coordinates, the part its polygon's plane cuts away, each occluder's shadow, what is left and its area (the exact fraction, `reference::Reference::light_view_at`) |
 //!
 //! A bad request gets status 400 and `{"error": "…"}`, which the page shows. `light=x,y,z`
 //! moves the first light (a point, spot or area light's position or corner; a directional
@@ -130,6 +131,7 @@ impl Explorer {
             }
             "api/trace" => self.trace(query).map(|t| Response::json(&t)),
             "api/picture" => self.picture(query),
+            "api/light" => self.light_view(query).map(|v| Response::json(&v)),
             _ => return Response::error(404, &format!("no such page: {path}")),
         };
         answer.unwrap_or_else(|e| Response::error(400, &e.to_string()))
@@ -181,7 +183,7 @@ impl Explorer {
                 "width" => r.width = side("width", &value)?,
                 "height" => r.height = side("height", &value)?,
                 "light" => r.light = Some(point(&value)?),
-                "line" | "index" => {}
+                "line" | "index" | "x" => {}
                 _ => return Err(Error::InvalidOption(format!("unknown parameter '{key}'"))),
             }
         }
@@ -260,6 +262,43 @@ impl Explorer {
             Some(png) => Ok(Response::ok("image/png", png.clone())),
             None => Err(Error::InvalidOption(format!("no such picture (this stage has {})", shown.pictures.len()))),
         }
+    }
+
+    /// What the point seen at pixel `(x, line)` sees of the scene's first area light, as the
+    /// reference finds it ([`Reference::light_view_at`]): the light as the unit square of
+    /// its coordinates, the part its plane cuts away, each occluder's shadow on it, what is
+    /// left and its area, the exact fraction. `{"light": null}` without an area light.
+    fn light_view(&self, query: &str) -> Result<Value> {
+        let r = self.request(query)?;
+        let number = |key: &str, below: u32| -> Result<u32> {
+            let (_, v) = pairs(query)
+                .find(|(k, _)| k == key)
+                .ok_or_else(|| Error::InvalidOption(format!("missing parameter '{key}'")))?;
+            match v.parse::<u32>() {
+                Ok(n) if n < below => Ok(n),
+                _ => Err(Error::out_of_range(key, &v, format!("a whole number below {below}"))),
+            }
+        };
+        let (x, line) = (number("x", r.width)?, number("line", r.height)?);
+        let scene = self.scene_for(&r)?;
+        let Some(light) = scene.lights().iter().position(|l| matches!(l.kind, LightKind::Area { .. })) else {
+            return Ok(json!({ "light": null }));
+        };
+        let ring = |r: &[glam::DVec2]| r.iter().map(|q| [q.x, q.y]).collect::<Vec<_>>();
+        let seen = Reference::new(&scene).light_view_at(light, x as f64 + 0.5, line as f64 + 0.5);
+        Ok(match seen {
+            None => json!({ "light": light, "x": x, "line": line, "seen": false }),
+            Some(v) => json!({
+                "light": light,
+                "x": x,
+                "line": line,
+                "seen": true,
+                "fraction": v.fraction,
+                "cut": ring(&v.cut),
+                "hidden": v.hidden.iter().map(|(poly, r)| json!({ "poly": poly, "ring": ring(r) })).collect::<Vec<_>>(),
+                "visible": v.visible.iter().map(|r| ring(r)).collect::<Vec<_>>(),
+            }),
+        })
     }
 
     /// Traces the requested line.
@@ -412,7 +451,7 @@ pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: 
     for shadows in stages {
         let r = Request { shadows: shadows.clone(), width, height, light: None };
         let shown = match explorer.show(&r) {
-            Err(Error::NotApplicable(_)) => continue,
+            Err(Error::NotApplicable { .. }) => continue,
             other => other?,
         };
         let name = shadows.name();

@@ -80,16 +80,18 @@ impl Sweep {
     pub fn scene(self, value: f64, o: &ScaleOptions) -> Result<Scene> {
         let (w, h) = (o.width, o.height);
         match self {
-            Sweep::Cubes => generate::cubes(value as u32, true, w, h),
+            Sweep::Cubes => generate::cubes(value as u32, generate::Faces::Triangles, w, h),
             Sweep::Quads => generate::stacked_quads(value as u32, w, h),
             Sweep::Spheres => generate::spheres(value as u32, o.count, w, h),
-            Sweep::Scattered => generate::scattered(value as u32, o.size, false, w, h),
-            Sweep::Clustered => generate::scattered(value as u32, o.size, true, w, h),
-            Sweep::Size => generate::scattered(o.count, value, false, w, h),
-            Sweep::Resolution => generate::cubes(10, true, value as u32, (value * 9.0 / 16.0).max(1.0) as u32),
+            Sweep::Scattered => generate::scattered(value as u32, o.size, generate::Placement::Uniform, w, h),
+            Sweep::Clustered => generate::scattered(value as u32, o.size, generate::Placement::Clustered, w, h),
+            Sweep::Size => generate::scattered(o.count, value, generate::Placement::Uniform, w, h),
+            Sweep::Resolution => {
+                generate::cubes(10, generate::Faces::Triangles, value as u32, (value * 9.0 / 16.0).max(1.0) as u32)
+            }
             Sweep::Samples => {
                 // The cubes' point light made a 2×2 square light (as s1a is s1's).
-                let mut scene = generate::cubes(10, true, w, h)?;
+                let mut scene = generate::cubes(10, generate::Faces::Triangles, w, h)?;
                 let crate::scene::LightKind::Point { position: at } = scene.lights[0].kind else {
                     return Err(Error::Internal("the cubes scene's light is not a point light".into()));
                 };
@@ -166,7 +168,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
     std::fs::create_dir_all(&o.out).map_err(|e| Error::Write { path: o.out.clone(), source: e })?;
     let (kind, name) = o.counter.split_once('.').unwrap_or(("visibility", &o.counter));
     if kind != "visibility" && kind != "shadow" {
-        return Err(Error::InvalidOption(format!("counter '{}' is not visibility.NAME or shadow.NAME", o.counter)));
+        return Err(Error::out_of_range("counter", format!("'{}'", o.counter), "visibility.NAME or shadow.NAME"));
     }
     let mut points = Vec::new();
     let mut known = std::collections::BTreeSet::new();
@@ -183,7 +185,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
                 Ok(m) => m,
                 // A method refused at one point (a shadow map per sample of a fine grid) is
                 // said so, and the sweep goes on.
-                Err(e @ (Error::OverBudget { .. } | Error::NotApplicable(_))) => {
+                Err(e @ (Error::OverBudget { .. } | Error::NotApplicable { .. })) => {
                     points.push(Point {
                         value,
                         visibility: v.name().into(),
@@ -218,11 +220,11 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
         // knows would plot zeros everywhere.
         if i == 0 && !known.is_empty() && !known.contains(name) {
             let names: Vec<&str> = known.iter().copied().collect();
-            return Err(Error::InvalidOption(format!(
-                "no method here counts '{}' (known {kind} counters: {})",
-                o.counter,
-                names.join(", ")
-            )));
+            return Err(Error::UnknownName {
+                kind: format!("{kind} counter of these methods"),
+                name: o.counter.clone(),
+                known: names.iter().map(|n| n.to_string()).collect(),
+            });
         }
     }
     let mut csv = format!(

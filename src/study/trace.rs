@@ -94,11 +94,8 @@ pub fn trace_lines(
 ) -> Result<()> {
     let view = View::new(&scene.camera);
     if lines.end > view.height || lines.is_empty() {
-        return Err(Error::InvalidOption(format!(
-            "line {} is outside the image (height {})",
-            lines.end.saturating_sub(1).max(lines.start),
-            view.height
-        )));
+        let line = lines.end.saturating_sub(1).max(lines.start);
+        return Err(Error::out_of_range("line", line, format!("inside the image (height {})", view.height)));
     }
     with_stage(scene, &view, shadows, |screen, vis, ctx, stage| {
         let edge = |e: (u32, u32, u32, f64, f64, f64)| {

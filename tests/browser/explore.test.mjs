@@ -21,8 +21,8 @@ const scene = resolve("scenes/cornell.toml");
 const shots = process.env.SCREENSHOTS;
 const LINE = 261;
 
-function startServer() {
-  const server = spawn(umbra, ["explore", scene, "--port", "0"], { stdio: ["ignore", "ignore", "pipe"] });
+function startServer(file = scene) {
+  const server = spawn(umbra, ["explore", file, "--port", "0"], { stdio: ["ignore", "ignore", "pipe"] });
   return new Promise((resolvePromise, reject) => {
     let err = "";
     const timer = setTimeout(() => reject(new Error(`no address from umbra explore: ${err}`)), 30000);
@@ -188,6 +188,39 @@ async function checkExported(browser) {
   }
 }
 
+// The scene with an area light: a picked pixel in its penumbra shows what its point sees of
+// the light (the visible part, the occluders' shadows), with a fraction strictly between 0
+// and 1 that is the reference's.
+async function checkLightView(browser) {
+  const [lights, at] = await startServer(resolve("scenes/lights.toml"));
+  try {
+    const errors = [];
+    const page = await newPage(browser, errors);
+    await page.goto(at);
+    await ready(page);
+    await page.check("#show-penumbra");
+    const frame = await page.evaluate(() => fetch(`api/frame?shadows=bouknight-kelley&width=${state.width}&height=${state.height}`).then((r) => r.json()));
+    const pixels = frame.penumbra.pixels;
+    assert.ok(pixels.length > 0, "the lights scene has a penumbra");
+    const [x, y] = pixels[Math.floor(pixels.length / 2)];
+    const scale = await page.evaluate(() => state.scale);
+    await page.locator("#overlay").click({ position: { x: (x + 0.5) * scale, y: (y + 0.5) * scale } });
+    await ready(page, y);
+    await page.waitForSelector("#light-view:not([hidden])", { timeout: 60000 });
+    const caption = await page.textContent("#light-caption");
+    const fraction = Number(caption.match(/Exact fraction ([0-9.]+)/)[1]);
+    assert.ok(fraction > 0 && fraction < 1, `a penumbra pixel's fraction: ${caption}`);
+    const want = await page.evaluate(([x, y]) => fetch(`api/light?shadows=bouknight-kelley&width=${state.width}&height=${state.height}&x=${x}&line=${y}`).then((r) => r.json()), [x, y]);
+    assert.equal(fraction.toFixed(4), want.fraction.toFixed(4), "the caption's fraction is the reference's");
+    assert.ok(want.hidden.length > 0 && want.visible.length > 0, "occluders and a visible part");
+    if (shots) await page.screenshot({ path: join(shots, "explore-light-view.png"), fullPage: false });
+    assert.deepEqual(errors, [], "console errors on the lights scene");
+    await page.close();
+  } finally {
+    lights.kill();
+  }
+}
+
 // A hung request fails the test instead of hanging CI.
 setTimeout(() => { console.error("explore browser test: timed out"); process.exit(1); }, 300000).unref();
 const [server, url] = await startServer();
@@ -198,6 +231,7 @@ const browser = await chromium.launch({
 });
 try {
   await checkLive(browser, url);
+  await checkLightView(browser);
   await checkExported(browser);
   console.log("explore browser test: ok");
 } finally {

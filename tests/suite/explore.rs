@@ -81,7 +81,7 @@ fn moving_the_light_moves_the_shadows() {
 fn bad_requests_get_a_json_error() {
     let explorer = Explorer::new(cornell(), "cornell");
     for (url, says) in [
-        ("/api/trace?line=480", "outside the image"),
+        ("/api/trace?line=480", "is not inside the image"),
         ("/api/trace?line=-1", "not a line number"),
         ("/api/trace", "missing parameter 'line'"),
         ("/api/trace?line=3&shadows=bogus", "unknown shadow method 'bogus'"),
@@ -161,4 +161,43 @@ fn the_frame_summary_carries_the_penumbra_of_an_area_light() {
     assert_eq!(p["pixels"].as_array().unwrap().len() as u64, penumbra);
     let c = &v["stats"]["shadow_counters"];
     assert_eq!((c["umbra_pixels"].as_u64(), c["penumbra_pixels"].as_u64()), (Some(umbra), Some(penumbra)));
+}
+
+/// A picked pixel's view of the area light (`api/light`): the reference's visible part of the
+/// light, its area the exact fraction `Reference::exact_fraction_at` gives, with the
+/// occluders' shadows; a pixel outside the image is refused.
+#[test]
+fn a_picked_pixel_shows_what_its_point_sees_of_the_area_light() {
+    let mut scene = umbra::Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/lights.toml")).unwrap();
+    let mut camera = scene.camera().clone();
+    (camera.width, camera.height) = (160, 120);
+    scene.set_camera(camera).unwrap();
+    let explorer = umbra::study::explore::Explorer::new(scene.clone(), "lights");
+    let oracle = umbra::reference::Reference::new(&scene);
+    let mut penumbra = 0;
+    for (x, y) in [(60, 80), (80, 90), (100, 70), (40, 100), (120, 60), (75, 85), (90, 95)] {
+        let r = explorer.handle(&format!("/api/light?width=160&height=120&x={x}&line={y}"));
+        assert_eq!(r.status, 200);
+        let v: Value = serde_json::from_slice(&r.body).unwrap();
+        assert_eq!(v["light"], 3);
+        let want = oracle.exact_fraction_at(3, x as f64 + 0.5, y as f64 + 0.5).unwrap();
+        let got = v["fraction"].as_f64().unwrap();
+        assert!((got - want).abs() < 1e-12, "({x}, {y}): {got} against {want}");
+        let seen = oracle.light_view_at(3, x as f64 + 0.5, y as f64 + 0.5).unwrap();
+        let area: f64 = seen.visible.iter().map(|r| signed_area(r)).sum::<f64>().abs();
+        assert!((area - want).abs() < 1e-9, "({x}, {y}): the visible rings' area {area} against {want}");
+        if want > 0.0 && want < 1.0 {
+            penumbra += 1;
+            assert!(!seen.hidden.is_empty(), "({x}, {y}): a penumbra point with no occluder");
+        }
+    }
+    assert!(penumbra > 0, "no pixel of the sample is in the penumbra");
+    let r = explorer.handle("/api/light?width=160&height=120&x=160&line=0");
+    assert_eq!(r.status, 400);
+    assert!(String::from_utf8_lossy(&r.body).contains("x 160 is not a whole number below 160"));
+}
+
+/// A ring's signed area (shoelace).
+fn signed_area(r: &[glam::DVec2]) -> f64 {
+    (0..r.len()).map(|i| r[i].perp_dot(r[(i + 1) % r.len()])).sum::<f64>() / 2.0
 }

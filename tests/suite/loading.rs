@@ -277,3 +277,47 @@ fn mesh_and_transform_constructors_build_scenes() {
     // The cube went where its transform put it: its top corner at 0.8 high.
     assert!(scene.vertices().iter().any(|v| (*v - DVec3::new(-0.7, 0.8, 0.8)).length() < 1e-12));
 }
+
+/// Errors carry what went wrong as data a program can match on: the unknown name and the
+/// known ones, the setting with its value and what is allowed, the scene part and its
+/// problem, the stage that does not apply.
+#[test]
+fn errors_are_typed_data() {
+    use umbra::shadow::WilliamsOptions;
+    use umbra::{generate, render, Error, Light, RenderOptions, ShadowMethod};
+    match "chalk".parse::<ShadowMethod>() {
+        Err(Error::UnknownName { kind, name, known }) => {
+            assert_eq!((kind.as_str(), name.as_str()), ("shadow method", "chalk"));
+            assert_eq!(known.len(), ShadowMethod::ALL.len());
+        }
+        other => panic!("{other:?}"),
+    }
+    let scene = generate::cubes(2, generate::Faces::Quads, 32, 24).unwrap();
+    let williams = ShadowMethod::Williams(WilliamsOptions { map_size: 0, ..Default::default() });
+    match render(&scene, &RenderOptions { shadows: williams, ..Default::default() }) {
+        Err(Error::OutOfRange { setting, value, allowed }) => {
+            assert_eq!((setting.as_str(), value.as_str()), ("williams: map size", "0"));
+            assert!(allowed.starts_with("in 1..="), "{allowed}");
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+    match umbra::check_gamma(0.0) {
+        Err(Error::OutOfRange { setting, .. }) => assert_eq!(setting, "gamma"),
+        other => panic!("{other:?}"),
+    }
+    let mut s = scene.clone();
+    match s.set_lights(vec![Light::point(glam::DVec3::new(f64::NAN, 1.0, 0.0))]) {
+        Err(Error::InvalidScene { part, problem }) => {
+            assert_eq!(part, "light 0");
+            assert!(problem.contains("finite"), "{problem}");
+        }
+        other => panic!("{other:?}"),
+    }
+    match render(&scene, &RenderOptions { shadows: ShadowMethod::Planar, ..Default::default() }) {
+        Err(Error::NotApplicable { stage, why }) => {
+            assert_eq!(stage, "planar");
+            assert!(why.contains("receiver"), "{why}");
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+}

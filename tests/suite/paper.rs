@@ -58,8 +58,8 @@ fn paper_failure_scenes_fail_where_the_docs_say() {
 #[test]
 fn crow_1977_is_exact_where_its_preconditions_hold() {
     let scenes = [
-        umbra::generate::cubes(3, false, 96, 72).unwrap(),
-        umbra::generate::cubes(2, true, 96, 72).unwrap(),
+        umbra::generate::cubes(3, umbra::generate::Faces::Quads, 96, 72).unwrap(),
+        umbra::generate::cubes(2, umbra::generate::Faces::Triangles, 96, 72).unwrap(),
         umbra::generate::spheres(800, 4, 96, 72).unwrap(),
     ];
     let lights = [DVec3::new(3.0, 6.0, 2.0), DVec3::new(-4.0, 3.0, -1.0), DVec3::new(0.3, 9.0, 0.2)];

@@ -115,7 +115,7 @@ fn repro_scenes() {
 #[test]
 fn awg_solid_cull_is_switchable() {
     use umbra::shadow::AthertonWeilerGreenbergOptions;
-    let scene = umbra::generate::cubes(3, false, 160, 120).unwrap();
+    let scene = umbra::generate::cubes(3, umbra::generate::Faces::Quads, 160, 120).unwrap();
     let awg = |solid_cull| {
         let shadows =
             ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions { solid_cull, ..Default::default() });
@@ -183,8 +183,8 @@ fn random_scenes() {
 #[test]
 fn generated_scenes() {
     let scenes = [
-        umbra::generate::cubes(4, true, 200, 120).unwrap(),
-        umbra::generate::cubes(3, false, 200, 120).unwrap(),
+        umbra::generate::cubes(4, umbra::generate::Faces::Triangles, 200, 120).unwrap(),
+        umbra::generate::cubes(3, umbra::generate::Faces::Quads, 200, 120).unwrap(),
         umbra::generate::spheres(3000, 5, 200, 120).unwrap(),
         umbra::generate::stacked_quads(8, 120, 90).unwrap(),
     ];
@@ -200,10 +200,12 @@ fn generated_scenes() {
 #[test]
 fn solid_cull_is_exercised_on_closed_meshes() {
     use umbra::shadow::BouknightKelleyOptions;
-    for (i, scene) in
-        [umbra::generate::cubes(4, true, 200, 120).unwrap(), umbra::generate::spheres(3000, 5, 200, 120).unwrap()]
-            .iter()
-            .enumerate()
+    for (i, scene) in [
+        umbra::generate::cubes(4, umbra::generate::Faces::Triangles, 200, 120).unwrap(),
+        umbra::generate::spheres(3000, 5, 200, 120).unwrap(),
+    ]
+    .iter()
+    .enumerate()
     {
         let opts = |solid_cull| umbra::RenderOptions {
             shadows: ShadowMethod::BouknightKelley(BouknightKelleyOptions { solid_cull, ..Default::default() }),
@@ -564,7 +566,7 @@ fn poly(f: &[[f64; 3]]) -> String {
 /// draws each as a fresh render does.
 #[test]
 fn a_renderer_keeps_adjacency_only_for_the_same_polygons() {
-    let cubes = umbra::generate::cubes(3, true, 160, 120).unwrap();
+    let cubes = umbra::generate::cubes(3, umbra::generate::Faces::Triangles, 160, 120).unwrap();
     let spheres = umbra::generate::spheres(800, 3, 160, 120).unwrap();
     for shadows in [ShadowMethod::Crow(Default::default()), ShadowMethod::StencilVolume(Default::default())] {
         let opts = umbra::RenderOptions { shadows, ..Default::default() };

@@ -48,7 +48,7 @@ fn random_scenes_agree_with_ray_cast() {
 #[test]
 fn generated_benchmark_scenes_agree() {
     let scenes = [
-        umbra::generate::cubes(3, true, 160, 90).unwrap(),
+        umbra::generate::cubes(3, umbra::generate::Faces::Triangles, 160, 90).unwrap(),
         umbra::generate::stacked_quads(16, 160, 90).unwrap(),
         umbra::generate::spheres(2000, 4, 160, 90).unwrap(),
     ];

@@ -972,7 +972,12 @@ fn export_shadows_command(e: ExportArgs) -> umbra::Result<()> {
 /// `umbra generate`: a benchmark scene written as files.
 fn generate_command(g: GenerateArgs) -> umbra::Result<()> {
     let scene = match g.family {
-        Family::Cubes => generate::cubes(g.n, !g.quads, g.width, g.height)?,
+        Family::Cubes => generate::cubes(
+            g.n,
+            if g.quads { generate::Faces::Quads } else { generate::Faces::Triangles },
+            g.width,
+            g.height,
+        )?,
         Family::Quads => generate::stacked_quads(g.depth, g.width, g.height)?,
         Family::Spheres => generate::spheres(g.triangles, g.count, g.width, g.height)?,
     };

@@ -107,7 +107,7 @@ fn generate_writes_a_loadable_scene() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let s = umbra::Scene::load(d.join("c.toml")).unwrap();
     assert_eq!(s.polygons().len(), 1 + 2 * 2 * 12);
-    let direct = umbra::generate::cubes(2, true, 64, 48).unwrap();
+    let direct = umbra::generate::cubes(2, umbra::generate::Faces::Triangles, 64, 48).unwrap();
     assert_eq!(s.vertices(), direct.vertices(), "written and generated scenes are the same");
 }
 
@@ -169,9 +169,12 @@ fn options_are_checked_wherever_they_are_used() {
     let w = ["--shadows", "williams"];
     refused(
         &[&["render", SMALL, "-o", "/dev/null", "--map-size", "2", "--shadow-filter", "pcf"][..], &w].concat(),
-        "wider than the 2x2 map",
+        "kernel size 3 is not within the 2x2 map",
     );
-    refused(&[&["render", SMALL, "-o", "/dev/null", "--map-size", "4", "--pcf-size", "5"][..], &w].concat(), "wider");
+    refused(
+        &[&["render", SMALL, "-o", "/dev/null", "--map-size", "4", "--pcf-size", "5"][..], &w].concat(),
+        "within the 4x4 map",
+    );
     refused(&[&["trace", SMALL, "--line", "3", "--map-size", "0"][..], &w].concat(), "map size 0");
     refused(&[&["trace", SMALL, "--line", "3", "--pcf-size", "2"][..], &w].concat(), "kernel size 2");
     refused(&[&["trace", SMALL, "--line", "3", "--bias", "nan"][..], &w].concat(), "bias");
@@ -186,7 +189,7 @@ fn options_are_checked_wherever_they_are_used() {
     let sweep = ["scale", "--sweep", "cubes", "--values", "1", "--width", "32", "--height", "24", "--out", sc];
     refused(
         &[&sweep[..], &["--counter", "nope"]].concat(),
-        "no method here counts 'nope' (known visibility counters: ",
+        "unknown visibility counter of these methods 'nope' (known: ",
     );
     refused(&[&sweep[..], &["--counter", "colour.spans"]].concat(), "not visibility.NAME or shadow.NAME");
     let (ok, err) = run(&[&sweep[..], &["--counter", "visibility.spans"]].concat());
@@ -260,8 +263,8 @@ fn bench_reports_spread_phases_and_memory() {
     assert_eq!(rows[3]["visibility"], "zbuffer");
     assert_eq!(rows[3]["shadows"], "crow");
     assert!(rows.iter().all(|r| r["speedup"].is_null() && r["speedup_best"].is_null()), "one count, no speed-up");
-    refused(&["bench", SMALL, "--runs", "0"], "at least one timed run");
-    refused(&["bench", SMALL, "--threads", "1,0"], "0 threads");
+    refused(&["bench", SMALL, "--runs", "0"], "bench: timed runs 0 is not at least 1");
+    refused(&["bench", SMALL, "--threads", "1,0"], "bench: threads 0 is not at least 1");
 }
 
 /// `bench --threads 1,2` renders each method at one and two threads in turn, one row per
@@ -353,7 +356,10 @@ fn receiver_makes_planar_shadows_usable_on_any_scene() {
         &["render", cornell, "--shadows", "planar", "--receiver", "the moon", "-o", out],
         "--receiver the moon: no object",
     );
-    refused(&["render", cornell, "--shadows", "planar", "--receiver", "9", "-o", out], "no object 9");
+    refused(
+        &["render", cornell, "--shadows", "planar", "--receiver", "9", "-o", out],
+        "object 9 is not an object of the scene",
+    );
     refused(&["scale", "--sweep", "cubes", "--values", "1", "--receiver", "auto"], "cannot be used here");
 }
 

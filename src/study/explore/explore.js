@@ -8,7 +8,7 @@ const STATIC = window.UMBRA_STATIC || null;
 
 const state = {
   scene: null, stage: "", paper: false, width: 0, height: 0, light: null,
-  line: 0, x: null, frame: null, trace: null, playing: null, token: 0, scale: 1,
+  line: 0, x: null, frame: null, trace: null, playing: null, token: 0, scale: 1, lightKey: null,
 };
 const staticLines = {};
 
@@ -515,6 +515,90 @@ function drawPixel(t) {
     .map((d) => `light ${d.light}.${d.sample}: ${(d.lit.find(([a, b]) => a <= state.x && state.x < b) || [0, 0, 0])[2]}`);
   $("pixel").textContent = `Pixel (${state.x}, ${t.line}): ` +
     (r ? `polygon ${r.poly} (face ${faceOf(r.poly)}); ${lit.join(", ")}` : "background");
+  loadLightView();
+}
+
+// --- the picked point's view of an area light -------------------------------------------------
+
+// What the picked pixel's point sees of the scene's first area light (the served page only:
+// any pixel can be asked; the export holds no such answers).
+async function loadLightView() {
+  const area = !STATIC && state.x !== null && state.scene.lights.some((l) => l.kind === "area");
+  if (!area) { $("light-view").hidden = true; state.lightKey = null; return; }
+  const key = `${params()}|${state.x}|${state.line}`;
+  if (state.lightKey === key) return;
+  state.lightKey = key;
+  try {
+    const v = await api("light", { x: state.x, line: state.line });
+    if (state.lightKey === key) drawLightView(v);
+  } catch (e) {
+    if (state.lightKey === key) showError(e);
+  }
+}
+
+// `ring` clipped to the box [lo, hi]² (Sutherland-Hodgman): shadows can reach far beyond the
+// light, and a canvas draws huge coordinates badly.
+function clipToBox(ring, lo, hi) {
+  let out = ring;
+  const sides = [[0, lo, 1], [0, hi, -1], [1, lo, 1], [1, hi, -1]];
+  for (const [axis, at, sign] of sides) {
+    const input = out;
+    out = [];
+    for (let i = 0; i < input.length; i++) {
+      const p = input[i], q = input[(i + 1) % input.length];
+      const dp = sign * (p[axis] - at), dq = sign * (q[axis] - at);
+      if (dp >= 0) out.push(p);
+      if ((dp >= 0) !== (dq >= 0)) {
+        const t = dp / (dp - dq);
+        out.push([p[0] + (q[0] - p[0]) * t, p[1] + (q[1] - p[1]) * t]);
+      }
+    }
+  }
+  return out;
+}
+
+function drawLightView(v) {
+  const c = $("light-canvas"), g = c.getContext("2d");
+  $("light-view").hidden = false;
+  const S = c.width, m = 36, side = S - 2 * m;
+  const X = (a) => m + a * side, Y = (b) => S - m - b * side;
+  const trace = (ring) => {
+    const r = clipToBox(ring, -0.15, 1.15);
+    r.forEach(([a, b], i) => (i ? g.lineTo(X(a), Y(b)) : g.moveTo(X(a), Y(b))));
+    g.closePath();
+  };
+  g.clearRect(0, 0, S, S);
+  if (!v.seen) {
+    $("light-caption").textContent = `No polygon is seen at pixel (${state.x}, ${state.line}).`;
+    return;
+  }
+  // The light: dark where hidden, yellow where the point sees it.
+  g.fillStyle = "#3a3a3a";
+  g.fillRect(X(0), Y(1), side, side);
+  g.fillStyle = "#ffd84a";
+  g.beginPath();
+  v.visible.forEach(trace);
+  g.fill("evenodd");
+  // Each occluder's shadow from the point, outlined; the part behind the polygon's plane dashed.
+  g.lineWidth = 1.5;
+  g.strokeStyle = "#3b8eea";
+  for (const h of v.hidden) { g.beginPath(); trace(h.ring); g.stroke(); }
+  if (v.cut.length) {
+    g.strokeStyle = "#d33"; g.setLineDash([5, 3]);
+    g.beginPath(); trace(v.cut); g.stroke();
+    g.setLineDash([]);
+  }
+  g.strokeStyle = "#000"; g.lineWidth = 1;
+  g.strokeRect(X(0), Y(1), side, side);
+  g.fillStyle = "#000"; g.font = "11px sans-serif";
+  g.fillText("a →", X(1) - 22, Y(0) + 16);
+  g.fillText("b ↑", X(0) - 30, Y(1) + 10);
+  const inPenumbra = v.fraction > 0 && v.fraction < 1;
+  $("light-caption").textContent =
+    `What the point at pixel (${v.x}, ${v.line}) sees of area light ${v.light}, drawn as the square of ` +
+    `its coordinates (a, b): yellow where it sees the light, dark where not; blue: the shadows of ` +
+    `${v.hidden.length} occluder(s) from the point` + (v.cut.length ? "; dashed red: the part behind its polygon's plane" : "") +
+    `. Exact fraction ${v.fraction.toFixed(4)}` + (inPenumbra ? " (penumbra)." : v.fraction === 0 ? " (umbra)." : " (lit).");
 }
 
 // --- set-up ---------------------------------------------------------------------------------
