@@ -44,6 +44,8 @@
 //! # Ok::<(), umbra::Error>(())
 //! ```
 #![warn(missing_docs)]
+// No public signature holds a type a program cannot name.
+#![warn(unnameable_types)]
 
 mod budget;
 mod bvh;

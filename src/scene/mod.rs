@@ -31,7 +31,9 @@ pub(crate) fn lone_cr_to_lf(text: &str) -> std::borrow::Cow<'_, str> {
 }
 
 use crate::error::{Error, Result};
-use crate::geometry::{classify_face, newell_normal, FaceShape, Plane};
+/// A polygon's plane ([`Polygon::plane`]), and what a light sample's side of it is asked of.
+pub use crate::geometry::Plane;
+use crate::geometry::{classify_face, newell_normal, FaceShape};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;

@@ -23,6 +23,7 @@ mod williams;
 use atherton_weiler_greenberg::AthertonWeilerGreenberg;
 pub use atherton_weiler_greenberg::{DetailPolygon, ShadowDatabase};
 use bouknight_kelley::BouknightKelley;
+pub use bouknight_kelley::Pairs;
 use crow::Crow;
 pub(crate) use nishita_nakamae::AreaLight;
 use nishita_nakamae::NishitaNakamae;

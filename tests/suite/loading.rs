@@ -321,3 +321,107 @@ fn errors_are_typed_data() {
         other => panic!("{:?}", other.map(|_| ())),
     }
 }
+
+/// The scene builder refuses what the loader refuses: each bad value, written in a scene file
+/// and given to `Scene::builder`, is an error both ways (the builder's names the part).
+#[test]
+fn the_builder_refuses_what_the_loader_refuses() {
+    use umbra::glam::{DVec3, Vec3};
+    use umbra::{Camera, Error, Light, Material, Mesh, Object};
+    let point = || Light::point(DVec3::new(0.0, 3.0, 0.0));
+    let spot = || Light::spot(DVec3::new(0.0, 3.0, 0.0), DVec3::NEG_Y, 30.0);
+    let grey = || Material::new("m");
+    type Case = (&'static str, &'static str, Box<dyn Fn() -> (Camera, Light, Material)>);
+    let camera = || Camera::new(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO);
+    let light_toml = "[[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\n";
+    let cases: Vec<Case> = vec![
+        (
+            "light position",
+            "[[light]]\nkind = \"point\"\nposition = [nan, 3.0, 0.0]\n",
+            Box::new(move || (camera(), Light::point(DVec3::new(f64::NAN, 3.0, 0.0)), grey())),
+        ),
+        (
+            "light position",
+            "[[light]]\nkind = \"point\"\nposition = [inf, 3.0, 0.0]\n",
+            Box::new(move || (camera(), Light::point(DVec3::new(f64::INFINITY, 3.0, 0.0)), grey())),
+        ),
+        (
+            "intensity",
+            "[[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = inf\n",
+            Box::new(move || (camera(), point().with(Vec3::ONE, f32::INFINITY), grey())),
+        ),
+        (
+            "attenuation",
+            "[[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\nattenuation = [0.0, 0.0, 0.0]\n",
+            Box::new(move || {
+                let mut l = point();
+                l.attenuation = [0.0; 3];
+                (camera(), l, grey())
+            }),
+        ),
+        (
+            "spot exponent",
+            "[[light]]\nkind = \"spot\"\nposition = [0.0, 3.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\nexponent = -5.0\n",
+            Box::new(move || {
+                let mut l = spot();
+                if let umbra::scene::LightKind::Spot { exponent, .. } = &mut l.kind {
+                    *exponent = -5.0;
+                }
+                (camera(), l, grey())
+            }),
+        ),
+        (
+            "roughness",
+            "[[material]]\nname = \"m\"\nroughness = 0.0\n",
+            Box::new(move || (camera(), point(), Material { roughness: 0.0, ..grey() })),
+        ),
+        (
+            "mirror",
+            "[[material]]\nname = \"m\"\nmirror = 2.0\n",
+            Box::new(move || (camera(), point(), Material { mirror: 2.0, ..grey() })),
+        ),
+        (
+            "shininess",
+            "[[material]]\nname = \"m\"\nshininess = -1.0\n",
+            Box::new(move || (camera(), point(), Material { shininess: -1.0, ..grey() })),
+        ),
+        (
+            "kd",
+            "[[material]]\nname = \"m\"\nkd = nan\n",
+            Box::new(move || (camera(), point(), Material { kd: f32::NAN, ..grey() })),
+        ),
+        ("camera size", "[camera]\nwidth = 0\n", Box::new(move || (Camera { width: 0, ..camera() }, point(), grey()))),
+        (
+            "camera fov",
+            "[camera]\nfov_y = 0.0\n",
+            Box::new(move || (Camera { fov_y: 0.0, ..camera() }, point(), grey())),
+        ),
+        (
+            "camera eye",
+            "[camera]\neye = [0.0, 0.0, 0.0]\n",
+            Box::new(move || (Camera { eye: DVec3::ZERO, ..camera() }, point(), grey())),
+        ),
+    ];
+    for (what, toml, build) in cases {
+        // The file: the bad value in its table, the rest as the builder's scene has it.
+        let src = if let Some(camera_keys) = toml.strip_prefix("[camera]\n") {
+            format!("[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n{camera_keys}{light_toml}").replacen(
+                "eye = [0.0, 0.0, 5.0]\n",
+                if camera_keys.starts_with("eye") { "" } else { "eye = [0.0, 0.0, 5.0]\n" },
+                1,
+            )
+        } else if toml.starts_with("[[light]]") {
+            format!("{CAMERA}{toml}")
+        } else {
+            format!("{CAMERA}{light_toml}{toml}")
+        };
+        assert!(load(&src).is_err(), "{what}: the loader took\n{src}");
+        let (camera, light, material) = build();
+        let built = Scene::builder(camera)
+            .material(material)
+            .light(light)
+            .object(Object::new(Mesh::quad([DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y, DVec3::ZERO])), "m")
+            .build();
+        assert!(matches!(built, Err(Error::InvalidScene { .. })), "{what}: the builder gave {:?}", built.map(|_| ()));
+    }
+}
