@@ -81,5 +81,5 @@ pub use reflection::ReflectionMethod;
 pub use render::{render, RenderOptions, Rendered, Renderer};
 pub use scene::{Camera, Light, Material, Mesh, Object, Scene, SceneBuilder};
 pub use shadow::ShadowMethod;
-pub use stats::{Counters, Stats, Times};
+pub use stats::{Counter, Counters, Stats, Times};
 pub use visibility::VisibilityMethod;

@@ -313,7 +313,7 @@ fn frame_pass(
         !(opts.back_face_cull && whole.get(solid) == Some(&true) && scene.turned_away_on_solid(i, eye, &closed))
     };
     let screen = view.screen_polygons_in(scene, seen, pools.stash.take());
-    stats.visibility_counters.add("screen_polygons", screen.len() as u64);
+    stats.visibility_counters.add(crate::stats::Counter::ScreenPolygons, screen.len() as u64);
     stats.time_ms.view = ms(t.elapsed());
 
     let t = Instant::now();
@@ -378,8 +378,8 @@ fn frame_pass(
     // Seed 000's umbra and penumbra of the area lights, counted over the visible pixels.
     if (0..frame.light.len()).any(|k| frame.is_area(k)) {
         let (umbra, penumbra) = frame.umbra_and_penumbra();
-        stats.shadow_counters.add("umbra_pixels", umbra);
-        stats.shadow_counters.add("penumbra_pixels", penumbra);
+        stats.shadow_counters.add(crate::stats::Counter::UmbraPixels, umbra);
+        stats.shadow_counters.add(crate::stats::Counter::PenumbraPixels, penumbra);
     }
     stats.time_ms.total = ms(start.elapsed());
     // Empty unless asked for: the stages keep outlines only then (`ShadowContext::keep_outlines`).
@@ -529,7 +529,7 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
         shading += t2.elapsed();
     }
     walker.finish(&mut shadow);
-    shadow.add("self_shadowed_runs", self_shadowed);
+    shadow.add(crate::stats::Counter::SelfShadowedRuns, self_shadowed);
     (shadow, walking, shading)
 }
 

@@ -1227,18 +1227,18 @@ impl ShadowDatabase {
             samples[s].extend(lit);
             stats.add(&st);
         }
-        counters.add("light_space_fragments", stats.fragments);
-        counters.add("clip_operations", stats.clips);
-        counters.add("interpenetration_splits", stats.splits);
-        counters.add("area_sort_depth_max", stats.depth_max);
-        counters.add("light_view_tiles", stats.tiles);
-        counters.add("light_view_backgrounds", stats.backgrounds_found);
-        counters.add("light_view_lone", stats.lone);
+        counters.add(crate::stats::Counter::LightSpaceFragments, stats.fragments);
+        counters.add(crate::stats::Counter::ClipOperations, stats.clips);
+        counters.add(crate::stats::Counter::InterpenetrationSplits, stats.splits);
+        counters.add(crate::stats::Counter::AreaSortDepthMax, stats.depth_max);
+        counters.add(crate::stats::Counter::LightViewTiles, stats.tiles);
+        counters.add(crate::stats::Counter::LightViewBackgrounds, stats.backgrounds_found);
+        counters.add(crate::stats::Counter::LightViewLone, stats.lone);
         let detail: usize = samples.iter().map(Vec::len).sum();
         let verts: usize = samples.iter().flatten().flat_map(|d| &d.rings).map(Vec::len).sum();
-        counters.add("detail_polygons", detail as u64);
-        counters.add("detail_vertices", verts as u64);
-        counters.add("pass1_us", t.elapsed().as_micros() as u64);
+        counters.add(crate::stats::Counter::DetailPolygons, detail as u64);
+        counters.add(crate::stats::Counter::DetailVertices, verts as u64);
+        counters.add(crate::stats::Counter::Pass1Us, t.elapsed().as_micros() as u64);
         Ok(ShadowDatabase { samples })
     }
 
@@ -1347,7 +1347,7 @@ impl<'a> AthertonWeilerGreenberg<'a> {
                 }
                 let mut overlay = Overlay::from_receivers(view.height, ctx.keep_outlines, &receivers, Vec::as_slice);
                 overlay.add_wholes(&wholes);
-                counters.add("detail_polygons_in_view", overlay.len() as u64);
+                counters.add(crate::stats::Counter::DetailPolygonsInView, overlay.len() as u64);
                 detail.push(overlay);
             }
         }

@@ -93,7 +93,7 @@ fn shadow_polygons(
 ) -> (Overlay, FxHashMap<u32, Pairs>) {
     let scene = ctx.scene;
     let n = scene.polygons.len();
-    counters.add("pairs", (n as u64) * (n as u64).saturating_sub(1));
+    counters.add(crate::stats::Counter::Pairs, (n as u64) * (n as u64).saturating_sub(1));
     let seen = |i: usize| !options.seen_receivers || ctx.visible[i];
     let receivers: Vec<u32> = (0..n as u32)
         .into_par_iter()
@@ -106,11 +106,11 @@ fn shadow_polygons(
         .filter(|&i| casting(i as usize))
         .partition(|&i| !(options.solid_cull && faces_away_on_solid(scene, i as usize, sample, &closed)));
     if options.solid_cull {
-        counters.add("casters_dropped_facing_away", dropped.len() as u64);
+        counters.add(crate::stats::Counter::CastersDroppedFacingAway, dropped.len() as u64);
     }
-    counters.add("receivers", receivers.len() as u64);
-    counters.add("casters", casters.len() as u64);
-    counters.add("pairs_with_roles", receivers.len() as u64 * casters.len() as u64);
+    counters.add(crate::stats::Counter::Receivers, receivers.len() as u64);
+    counters.add(crate::stats::Counter::Casters, casters.len() as u64);
+    counters.add(crate::stats::Counter::PairsWithRoles, receivers.len() as u64 * casters.len() as u64);
 
     let t = Instant::now();
     let extents = options.prefilter.then(|| Extents::new(scene, sample, &casters, &receivers));
@@ -118,7 +118,7 @@ fn shadow_polygons(
         Some(e) if options.sphere_grid => (Some(SphereGrid::new(e, sample, &casters)), None),
         e => (None, e),
     };
-    counters.add("prefilter_grid_us", t.elapsed().as_micros() as u64);
+    counters.add(crate::stats::Counter::PrefilterGridUs, t.elapsed().as_micros() as u64);
 
     // Receivers differ widely in cost, so the loop is cut into pieces of at most
     // `RECEIVERS_PER_PIECE` (rayon's own cut leaves a few long pieces, and a thread that
@@ -157,21 +157,21 @@ fn shadow_polygons(
 
     let (overlay, total, kept_pairs) = merge(ctx, per_receiver);
     if options.prefilter {
-        counters.add("pairs_kept_by_prefilter", total.kept);
+        counters.add(crate::stats::Counter::PairsKeptByPrefilter, total.kept);
         if !options.sphere_grid {
-            counters.add("pairs_tested_by_prefilter", total.tested);
+            counters.add(crate::stats::Counter::PairsTestedByPrefilter, total.tested);
         }
     }
     if options.drop_behind {
-        counters.add("pairs_dropped_behind", total.behind);
+        counters.add(crate::stats::Counter::PairsDroppedBehind, total.behind);
     }
     if options.wedge {
-        counters.add("pairs_outside_receiver", total.outside);
+        counters.add(crate::stats::Counter::PairsOutsideReceiver, total.outside);
     }
-    counters.add("projections_empty", total.empty);
-    counters.add("shadow_polygons", overlay.len() as u64);
-    counters.add("prefilter_cpu_us", total.prefilter_ns / 1000);
-    counters.add("projection_cpu_us", total.projection_ns / 1000);
+    counters.add(crate::stats::Counter::ProjectionsEmpty, total.empty);
+    counters.add(crate::stats::Counter::ShadowPolygons, overlay.len() as u64);
+    counters.add(crate::stats::Counter::PrefilterCpuUs, total.prefilter_ns / 1000);
+    counters.add(crate::stats::Counter::ProjectionCpuUs, total.projection_ns / 1000);
     (overlay, kept_pairs)
 }
 
@@ -641,9 +641,9 @@ impl ShadowWalker for Walker<'_> {
     }
 
     fn finish(&mut self, counters: &mut Counters) {
-        counters.add("segments_examined", self.segments);
-        counters.add("segment_splits", self.splits);
-        counters.add("recursion_depth_max", self.depth_max as u64);
+        counters.add(crate::stats::Counter::SegmentsExamined, self.segments);
+        counters.add(crate::stats::Counter::SegmentSplits, self.splits);
+        counters.add(crate::stats::Counter::RecursionDepthMax, self.depth_max as u64);
     }
 }
 

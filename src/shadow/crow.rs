@@ -293,8 +293,8 @@ impl ShadowWalker for Walker<'_> {
     }
 
     fn finish(&mut self, counters: &mut Counters) {
-        counters.add("runs_counted", self.runs);
-        counters.add("events", self.events_total);
-        counters.add("runs_split", self.split);
+        counters.add(crate::stats::Counter::RunsCounted, self.runs);
+        counters.add(crate::stats::Counter::Events, self.events_total);
+        counters.add(crate::stats::Counter::RunsSplit, self.split);
     }
 }

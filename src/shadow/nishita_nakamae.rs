@@ -403,7 +403,7 @@ impl<'a> NishitaNakamae<'a> {
                 gather(ctx, source, per, bodies, counters)
             })
             .collect();
-        counters.add("receivers", receivers.len() as u64 * scene.lights.len() as u64);
+        counters.add(crate::stats::Counter::Receivers, receivers.len() as u64 * scene.lights.len() as u64);
         NishitaNakamae { ctx, lights }
     }
 }
@@ -438,10 +438,10 @@ fn gather(
     let mut umbra = Overlay::from_tables(height, false, umbras);
     umbra.add_wholes(&dark);
     let penumbra = Overlay::from_tables(height, false, penumbras);
-    counters.add("pairs", pairs);
-    counters.add("umbra_polygons", umbra.len() as u64);
-    counters.add("penumbra_polygons", penumbra.len() as u64);
-    counters.add("receivers_searched_everywhere", everywhere.len() as u64);
+    counters.add(crate::stats::Counter::Pairs, pairs);
+    counters.add(crate::stats::Counter::UmbraPolygons, umbra.len() as u64);
+    counters.add(crate::stats::Counter::PenumbraPolygons, penumbra.len() as u64);
+    counters.add(crate::stats::Counter::ReceiversSearchedEverywhere, everywhere.len() as u64);
     LightShadows { source, umbra, penumbra, occluder, everywhere, bodies }
 }
 
@@ -878,10 +878,10 @@ impl ShadowWalker for Walker<'_> {
     }
 
     fn finish(&mut self, counters: &mut Counters) {
-        counters.add("umbra_pixels_at_once", self.tally.dark);
-        counters.add("lit_pixels_at_once", self.tally.lit);
-        counters.add("penumbra_pixels_clipped", self.tally.penumbra);
-        counters.add("light_parts_hidden", self.scratch.clips);
-        counters.add("convex_solid_shadows", self.scratch.body_hulls);
+        counters.add(crate::stats::Counter::UmbraPixelsAtOnce, self.tally.dark);
+        counters.add(crate::stats::Counter::LitPixelsAtOnce, self.tally.lit);
+        counters.add(crate::stats::Counter::PenumbraPixelsClipped, self.tally.penumbra);
+        counters.add(crate::stats::Counter::LightPartsHidden, self.scratch.clips);
+        counters.add(crate::stats::Counter::ConvexSolidShadows, self.scratch.body_hulls);
     }
 }

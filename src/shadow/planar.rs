@@ -83,7 +83,7 @@ impl<'a> Planar<'a> {
                     .into(),
             });
         }
-        counters.add("receivers", receivers.len() as u64);
+        counters.add(crate::stats::Counter::Receivers, receivers.len() as u64);
         let mut shadows = Vec::new();
         let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
         let (mut clipped, mut projected) = (Vec::new(), Vec::new());
@@ -115,7 +115,7 @@ impl<'a> Planar<'a> {
                 }
             }
             overlay.finish();
-            counters.add("shadow_polygons", overlay.len() as u64);
+            counters.add(crate::stats::Counter::ShadowPolygons, overlay.len() as u64);
             shadows.push(overlay);
         }
         Ok(Planar { ctx, shadows })

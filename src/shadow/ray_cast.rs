@@ -32,7 +32,7 @@ impl<'a> RayCastShadows<'a> {
     pub fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
         let s = ctx.scene;
         let casters: Vec<u32> = (0..s.polygons.len() as u32).filter(|&i| s.casts_shadows(i as usize)).collect();
-        counters.add("casters", casters.len() as u64);
+        counters.add(crate::stats::Counter::Casters, casters.len() as u64);
         RayCastShadows { ctx, bvh: Bvh::new(s, casters) }
     }
 }
@@ -73,6 +73,6 @@ impl ShadowWalker for Walker<'_> {
     }
 
     fn finish(&mut self, counters: &mut Counters) {
-        counters.add("shadow_rays", self.rays);
+        counters.add(crate::stats::Counter::ShadowRays, self.rays);
     }
 }

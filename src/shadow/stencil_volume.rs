@@ -87,7 +87,7 @@ impl<'a> StencilVolume<'a> {
             })
             .collect();
         ctx.pools.u32.give(surface);
-        counters.add("stencil_writes", writes);
+        counters.add(crate::stats::Counter::StencilWrites, writes);
         Ok(StencilVolume { ctx, lit })
     }
 }

@@ -918,27 +918,28 @@ impl ScreenVolumes {
         };
         let eye_count = pieces.iter().map(|p| p.eye_count).sum::<i32>();
         if options.construction == super::Construction::Crow1977 && counting == Counting::ZPass {
-            counters.add("eye_count", eye_count.max(0) as u64);
+            counters.add(crate::stats::Counter::EyeCount, eye_count.max(0) as u64);
         }
         let sum = |of: &dyn Fn(&Piece) -> u64| pieces.iter().map(of).sum::<u64>();
-        counters.add("merged_edges", adjacency.edges.len() as u64);
-        counters.add("polygons_apart", adjacency.apart.len() as u64);
-        counters.add("sides_weight_1", sum(&|p| p.weights[0]));
-        counters.add("sides_weight_2", sum(&|p| p.weights[1]));
-        let names = [
-            "shadow_polygons_side",
-            "shadow_polygons_front_cap",
-            "shadow_polygons_back_cap",
-            "shadow_polygons_near_cap",
-            "shadow_polygons_far_cap",
+        counters.add(crate::stats::Counter::MergedEdges, adjacency.edges.len() as u64);
+        counters.add(crate::stats::Counter::PolygonsApart, adjacency.apart.len() as u64);
+        counters.add(crate::stats::Counter::SidesWeight1, sum(&|p| p.weights[0]));
+        counters.add(crate::stats::Counter::SidesWeight2, sum(&|p| p.weights[1]));
+        use crate::stats::Counter;
+        let kinds = [
+            Counter::ShadowPolygonsSide,
+            Counter::ShadowPolygonsFrontCap,
+            Counter::ShadowPolygonsBackCap,
+            Counter::ShadowPolygonsNearCap,
+            Counter::ShadowPolygonsFarCap,
         ];
-        for (k, name) in names.into_iter().enumerate() {
-            counters.add(name, sum(&|p| p.made[k]));
+        for (k, counter) in kinds.into_iter().enumerate() {
+            counters.add(counter, sum(&|p| p.made[k]));
         }
         let outside = sum(&|p| p.outside);
         let out = ScreenVolumes::joined(pieces);
-        counters.add("screen_shadow_polygons", out.polys.len() as u64);
-        counters.add("sides_outside_sight", outside);
+        counters.add(crate::stats::Counter::ScreenShadowPolygons, out.polys.len() as u64);
+        counters.add(crate::stats::Counter::SidesOutsideSight, outside);
         out
     }
 

@@ -665,7 +665,7 @@ impl LightMaps {
         let covered = if seen.is_empty() { &corners } else { &seen };
         let maps = match sample {
             LightSample::Directional(d) => {
-                counters.add("maps_ortho", 1);
+                counters.add(crate::stats::Counter::MapsOrtho, 1);
                 let proj = orthographic(across(ctx.view, d), d, covered, &corners, o.map_size);
                 LightMaps::Single(Box::new(DepthMap::render(ctx, proj, sample, o)))
             }
@@ -681,12 +681,12 @@ impl LightMaps {
                     .acos();
                 let near = 1e-6 * ctx.extent;
                 if half < 80f64.to_radians() {
-                    counters.add("maps_perspective", 1);
+                    counters.add(crate::stats::Counter::MapsPerspective, 1);
                     let fov = (2.0 * half).to_degrees() * 1.02 + 0.1;
                     let proj = pinhole(s, axis, across(ctx.view, axis).cross(axis), fov, o.map_size, near);
                     LightMaps::Single(Box::new(DepthMap::render(ctx, proj, sample, o)))
                 } else {
-                    counters.add("maps_cube_faces", 6);
+                    counters.add(crate::stats::Counter::MapsCubeFaces, 6);
                     let face =
                         |(axis, up)| DepthMap::render(ctx, pinhole(s, axis, up, 90.0, o.map_size, near), sample, o);
                     LightMaps::Cube(Box::new(CUBE.map(face)), s)
@@ -812,7 +812,7 @@ impl<'a> Williams<'a> {
         let bias = options.bias.unwrap_or(0.0);
         let samples: Vec<_> = ctx.all_samples().collect();
         let maps = samples.iter().map(|&(_, _, s)| LightMaps::new(ctx, s, &options, counters)).collect();
-        counters.add("map_texels", (options.map_size as u64).pow(2));
+        counters.add(crate::stats::Counter::MapTexels, (options.map_size as u64).pow(2));
         let mut stage = Williams { ctx, options, bias, maps, blurred: Vec::new() };
         if let ShadowFilter::SoftEdge(_) = stage.options.filter {
             stage.blurred = samples.iter().map(|&(l, s, _)| stage.soft_edge_buffer(l, s)).collect();
@@ -990,7 +990,7 @@ impl ShadowWalker for Walker<'_> {
     }
 
     fn finish(&mut self, counters: &mut Counters) {
-        counters.add("map_lookups", self.lookups);
+        counters.add(crate::stats::Counter::MapLookups, self.lookups);
     }
 }
 

@@ -203,7 +203,7 @@ pub fn scale(o: &ScaleOptions) -> Result<Vec<Point>> {
             let r = &m.last;
             let counters = if kind == "shadow" { &r.stats.shadow_counters } else { &r.stats.visibility_counters };
             known.extend(counters.iter().map(|(k, _)| k));
-            let counter = counters.get(name);
+            let counter = counters.get_named(name).unwrap_or(0);
             let area_error = exact.as_ref().map(|e| super::compare::AreaError::of(&scene, e, &r.frame).mean);
             points.push(Point {
                 value,

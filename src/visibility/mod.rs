@@ -126,7 +126,7 @@ pub(crate) fn resolve(vis: &dyn Visibility, height: u32, counters: &mut Counters
         runs.lines.extend(lines);
         counters.merge(&c);
     }
-    counters.add("runs", runs.count() as u64);
+    counters.add(crate::stats::Counter::Runs, runs.count() as u64);
     runs
 }
 

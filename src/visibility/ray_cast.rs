@@ -35,7 +35,7 @@ impl Visibility for RayCastVisibility<'_> {
     fn walk(&self, lines: Range<u32>, counters: &mut Counters, f: &mut dyn FnMut(u32, &[Run])) {
         let mut row = vec![u32::MAX; self.view.width as usize];
         let mut runs = Vec::new();
-        counters.add("rays", lines.len() as u64 * row.len() as u64);
+        counters.add(crate::stats::Counter::Rays, lines.len() as u64 * row.len() as u64);
         for y in lines {
             for (x, id) in row.iter_mut().enumerate() {
                 *id = self.pixel(x as u32, y).unwrap_or(u32::MAX);

@@ -50,7 +50,7 @@ impl<'a> ScanlineVisibility<'a> {
     pub fn new(scene: &'a Scene, screen: &'a Screen, view: &View, pools: &Pools, counters: &mut Counters) -> Self {
         let band = band_height(view.height);
         let members = screen.band_members(view.height, band);
-        counters.add("band_members", members.iter().map(Vec::len).sum::<usize>() as u64);
+        counters.add(crate::stats::Counter::BandMembers, members.iter().map(Vec::len).sum::<usize>() as u64);
         ScanlineVisibility {
             scene,
             screen,
@@ -118,7 +118,7 @@ impl<'a> ScanlineVisibility<'a> {
         let mut scratch: BandScratch = self.stash.take();
         self.build_band(&lines, &mut scratch);
         let BandScratch { table, planes, polys, set } = &mut scratch;
-        counters.add("edges", table.len() as u64);
+        counters.add(crate::stats::Counter::Edges, table.len() as u64);
         let mut aet = ActiveEdges::new(table, lines.clone());
         let mut runs = Vec::new();
         let mut walk = Walk {
@@ -162,14 +162,14 @@ impl<'a> ScanlineVisibility<'a> {
             next = line + 1;
         }
         emit_empty_until(lines.end, &mut next, f);
-        counters.add("edges_entered", aet.entered);
-        counters.add("spans", walk.spans);
-        counters.add("span_splits", walk.splits);
-        counters.add("depth_tests", walk.depth_tests);
-        counters.add("active_edges_max", max_active as u64);
+        counters.add(crate::stats::Counter::EdgesEntered, aet.entered);
+        counters.add(crate::stats::Counter::Spans, walk.spans);
+        counters.add(crate::stats::Counter::SpanSplits, walk.splits);
+        counters.add(crate::stats::Counter::DepthTests, walk.depth_tests);
+        counters.add(crate::stats::Counter::ActiveEdgesMax, max_active as u64);
         // Working memory of this band: its table, active edges, the span set, the runs.
         let band_bytes = table.bytes() + aet.bytes() + set.bytes() + runs.capacity() * std::mem::size_of::<Run>();
-        counters.add("band_bytes_max", band_bytes as u64);
+        counters.add(crate::stats::Counter::BandBytesMax, band_bytes as u64);
         drop(aet);
         self.stash.put(scratch);
     }

@@ -23,9 +23,9 @@ impl ZBufferVisibility {
     /// Rasterises every screen polygon into buffers taken from `pools`.
     pub(crate) fn new(screen: &Screen, view: &View, pools: &Pools, counters: &mut Counters) -> Self {
         let buffers = rasterize::<f64>(screen, view.width, view.height, Some(pools.u32.take()), pools.f64.take());
-        counters.add("depth_tests", buffers.tests);
-        counters.add("depth_writes", buffers.writes);
-        counters.add("buffer_bytes", (buffers.ids.len() * 4 + buffers.depth.len() * 8) as u64);
+        counters.add(crate::stats::Counter::DepthTests, buffers.tests);
+        counters.add(crate::stats::Counter::DepthWrites, buffers.writes);
+        counters.add(crate::stats::Counter::BufferBytes, (buffers.ids.len() * 4 + buffers.depth.len() * 8) as u64);
         pools.f64.give(buffers.depth);
         ZBufferVisibility { width: view.width, ids: buffers.ids, pools: pools.clone() }
     }

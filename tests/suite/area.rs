@@ -121,7 +121,7 @@ fn convex_solids_hide_as_one() {
     for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
         let opts = umbra::RenderOptions { visibility: v, shadows: NN, ..Default::default() };
         let r = umbra::render(&scene, &opts).unwrap();
-        assert!(r.stats.shadow_counters.get("convex_solid_shadows") > 100, "{:?}", r.stats.shadow_counters);
+        assert!(r.stats.shadow_counters.get(umbra::Counter::ConvexSolidShadows) > 100, "{:?}", r.stats.shadow_counters);
         let (compared, penumbra) = assert_area_exact(&scene, &r.frame, &format!("convex solids behind {v}"));
         assert!(compared > 10_000 && penumbra > 500, "{compared} compared, {penumbra} in the penumbra");
     }

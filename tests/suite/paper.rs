@@ -100,14 +100,14 @@ fn the_paper_path_compares_every_ordered_pair() {
     };
     let paper = run(BouknightKelleyOptions::PAPER);
     let c = &paper.stats.shadow_counters;
-    assert_eq!(c.get("pairs"), n * (n - 1));
-    assert_eq!(c.get("receivers"), n, "every polygon is a receiver");
-    assert_eq!(c.get("pairs_tested_by_prefilter"), n * (n - 1), "every ordered pair is compared");
-    assert_eq!(c.get("pairs_dropped_behind"), 0, "the paper drops nothing unprojected");
-    assert_eq!(c.get("pairs_outside_receiver"), 0, "the paper has no wedge");
+    assert_eq!(c.get(umbra::Counter::Pairs), n * (n - 1));
+    assert_eq!(c.get(umbra::Counter::Receivers), n, "every polygon is a receiver");
+    assert_eq!(c.get(umbra::Counter::PairsTestedByPrefilter), n * (n - 1), "every ordered pair is compared");
+    assert_eq!(c.get(umbra::Counter::PairsDroppedBehind), 0, "the paper drops nothing unprojected");
+    assert_eq!(c.get(umbra::Counter::PairsOutsideReceiver), 0, "the paper has no wedge");
     // The default finds the same shadows with fewer tests, and lights the same pixels.
     let default = run(BouknightKelleyOptions::DEFAULT);
-    assert_eq!(default.stats.shadow_counters.get("pairs_tested_by_prefilter"), 0);
+    assert_eq!(default.stats.shadow_counters.get(umbra::Counter::PairsTestedByPrefilter), 0);
     assert_eq!(paper.frame.light, default.frame.light);
 }
 

@@ -141,7 +141,7 @@ fn the_solid_cull_changes_nothing_in_a_mirror() {
         render(&scene, &RenderOptions { shadows, ..Default::default() }).unwrap()
     };
     let (on, off) = (render_with(true), render_with(false));
-    assert!(on.stats.shadow_counters.get("casters_dropped_facing_away") > 0, "the closed block is culled");
+    assert!(on.stats.shadow_counters.get(umbra::Counter::CastersDroppedFacingAway) > 0, "the closed block is culled");
     assert_eq!(on.frame.light, off.frame.light);
     let differ = on.frame.color.iter().zip(&off.frame.color).filter(|(a, b)| a != b).count();
     assert_eq!(differ, 0, "{differ} pixels differ");

@@ -122,7 +122,7 @@ fn awg_solid_cull_is_switchable() {
         umbra::render(&scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
     };
     let (on, off) = (awg(true), awg(false));
-    let mapped = |r: &umbra::Rendered| r.stats.shadow_counters.get("light_space_fragments");
+    let mapped = |r: &umbra::Rendered| r.stats.shadow_counters.get(umbra::Counter::LightSpaceFragments);
     assert!(mapped(&off) > mapped(&on), "{} with the cull, {} without", mapped(&on), mapped(&off));
     assert_light_agree(&scene, &on.frame, &off.frame, "AWG with and without its solid cull");
 }
@@ -213,13 +213,18 @@ fn solid_cull_is_exercised_on_closed_meshes() {
         };
         let on = umbra::render(scene, &opts(true)).unwrap();
         let off = umbra::render(scene, &opts(false)).unwrap();
-        let (dropped, casters) =
-            (on.stats.shadow_counters.get("casters_dropped_facing_away"), off.stats.shadow_counters.get("casters"));
+        let (dropped, casters) = (
+            on.stats.shadow_counters.get(umbra::Counter::CastersDroppedFacingAway),
+            off.stats.shadow_counters.get(umbra::Counter::Casters),
+        );
         assert!(dropped * 3 > casters, "generated {i}: dropped {dropped} of {casters} casters");
-        assert_eq!(on.stats.shadow_counters.get("casters") + dropped, casters, "generated {i}");
-        assert!(on.stats.shadow_counters.get("shadow_polygons") < off.stats.shadow_counters.get("shadow_polygons"));
+        assert_eq!(on.stats.shadow_counters.get(umbra::Counter::Casters) + dropped, casters, "generated {i}");
+        assert!(
+            on.stats.shadow_counters.get(umbra::Counter::ShadowPolygons)
+                < off.stats.shadow_counters.get(umbra::Counter::ShadowPolygons)
+        );
         // The receiver wedge is at work on these triangles too (the exact set checks it).
-        let outside = off.stats.shadow_counters.get("pairs_outside_receiver");
+        let outside = off.stats.shadow_counters.get(umbra::Counter::PairsOutsideReceiver);
         assert!(outside > 0, "generated {i}: no caster found beside its receiver's wedge");
     }
 }
@@ -236,7 +241,7 @@ fn light_view_regions_are_exercised() {
     let options = umbra::shadow::AthertonWeilerGreenbergOptions { lone_sheets: false, ..Default::default() };
     let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg(options), ..Default::default() };
     let awg = umbra::render(&scene, &opts).unwrap();
-    let tiles = awg.stats.shadow_counters.get("light_view_tiles");
+    let tiles = awg.stats.shadow_counters.get(umbra::Counter::LightViewTiles);
     assert!(tiles > 4, "{tiles} regions");
     let bk = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::BouknightKelley(Default::default()));
     assert_light_agree(&scene, &bk, &awg.frame, "regions against bouknight-kelley");
@@ -463,7 +468,8 @@ fn random_open_meshes_lit_and_seen_from_all_round() {
         in_shadow += s;
         let opts =
             umbra::RenderOptions { shadows: ShadowMethod::BouknightKelley(Default::default()), ..Default::default() };
-        dropped += umbra::render(&scene, &opts).unwrap().stats.shadow_counters.get("casters_dropped_facing_away");
+        dropped +=
+            umbra::render(&scene, &opts).unwrap().stats.shadow_counters.get(umbra::Counter::CastersDroppedFacingAway);
     }
     assert!(in_shadow > 60 * 100, "only {in_shadow} pixels in shadow");
     assert_eq!(dropped, 0, "a polygon of an open mesh was left out");
@@ -592,7 +598,7 @@ fn a_stack_of_covering_polygons_is_not_cut_without_end() {
     let options = umbra::shadow::AthertonWeilerGreenbergOptions { lone_sheets: false, ..Default::default() };
     let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg(options), ..Default::default() };
     let awg = umbra::render(&scene, &opts).unwrap();
-    let tiles = awg.stats.shadow_counters.get("light_view_tiles");
+    let tiles = awg.stats.shadow_counters.get(umbra::Counter::LightViewTiles);
     assert!((1..=16).contains(&tiles), "{tiles} regions");
     let bk = frame(&scene, VisibilityMethod::Scanline, ShadowMethod::BouknightKelley(Default::default()));
     assert_light_agree(&scene, &bk, &awg.frame, "stacked quads against bouknight-kelley");
@@ -627,7 +633,7 @@ fn light_view_regions_follow_a_crowded_corner() {
     let options = umbra::shadow::AthertonWeilerGreenbergOptions { lone_sheets: false, ..Default::default() };
     let opts = umbra::RenderOptions { shadows: ShadowMethod::AthertonWeilerGreenberg(options), ..Default::default() };
     let awg = umbra::render(&scene, &opts).unwrap();
-    let tiles = awg.stats.shadow_counters.get("light_view_tiles");
+    let tiles = awg.stats.shadow_counters.get(umbra::Counter::LightViewTiles);
     assert!(tiles >= 8, "{tiles} regions");
     assert_light_agree(&scene, &reference(&scene), &awg.frame, "a crowded corner against ray-cast");
 }
@@ -651,7 +657,7 @@ fn convex_pieces_are_split_unless_stacked_deep() {
         });
         umbra::render(scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
     };
-    let detail = |r: &umbra::Rendered| r.stats.shadow_counters.get("detail_polygons");
+    let detail = |r: &umbra::Rendered| r.stats.shadow_counters.get(umbra::Counter::DetailPolygons);
     let spheres = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
     let (split, whole) = (awg(&spheres, true), awg(&spheres, false));
     assert!(detail(&split) > detail(&whole), "{} and {} detail polygons", detail(&split), detail(&whole));
@@ -679,10 +685,10 @@ fn a_floor_behind_everything_is_left_out_of_the_sort() {
         umbra::render(&scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
     };
     let (left_out, sorted) = (awg(true), awg(false));
-    let count = |r: &umbra::Rendered, c: &str| r.stats.shadow_counters.get(c);
-    assert!(count(&left_out, "light_view_backgrounds") > 0);
-    assert_eq!(count(&sorted, "light_view_backgrounds"), 0);
-    let clips = (count(&left_out, "clip_operations"), count(&sorted, "clip_operations"));
+    let count = |r: &umbra::Rendered, c: umbra::Counter| r.stats.shadow_counters.get(c);
+    assert!(count(&left_out, umbra::Counter::LightViewBackgrounds) > 0);
+    assert_eq!(count(&sorted, umbra::Counter::LightViewBackgrounds), 0);
+    let clips = (count(&left_out, umbra::Counter::ClipOperations), count(&sorted, umbra::Counter::ClipOperations));
     assert!(4 * clips.0 < clips.1, "{clips:?} clips");
     assert_light_agree(&scene, &reference(&scene), &left_out.frame, "backgrounds left out against ray-cast");
 }
@@ -705,14 +711,19 @@ fn lone_sheets_leave_the_sort() {
         umbra::render(&scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap()
     };
     let (lone, sorted, floor_meets) = (awg(true, true), awg(true, false), awg(false, true));
-    let count = |r: &umbra::Rendered, c: &str| r.stats.shadow_counters.get(c);
+    let count = |r: &umbra::Rendered, c: umbra::Counter| r.stats.shadow_counters.get(c);
     // About half of the five spheres' 2,640 triangles face the light.
-    assert!(count(&lone, "light_view_lone") > 2640 / 3, "{} lone", count(&lone, "light_view_lone"));
-    assert_eq!(count(&sorted, "light_view_lone"), 0);
-    assert_eq!(count(&floor_meets, "light_view_lone"), 0);
-    let clips = (count(&lone, "clip_operations"), count(&sorted, "clip_operations"));
+    assert!(
+        count(&lone, umbra::Counter::LightViewLone) > 2640 / 3,
+        "{} lone",
+        count(&lone, umbra::Counter::LightViewLone)
+    );
+    assert_eq!(count(&sorted, umbra::Counter::LightViewLone), 0);
+    assert_eq!(count(&floor_meets, umbra::Counter::LightViewLone), 0);
+    let clips = (count(&lone, umbra::Counter::ClipOperations), count(&sorted, umbra::Counter::ClipOperations));
     assert!(2 * clips.0 < clips.1, "{clips:?} clips");
-    let in_view = (count(&lone, "detail_polygons_in_view"), count(&sorted, "detail_polygons_in_view"));
+    let in_view =
+        (count(&lone, umbra::Counter::DetailPolygonsInView), count(&sorted, umbra::Counter::DetailPolygonsInView));
     assert!(in_view.0 > 0 && in_view.0 <= in_view.1, "{in_view:?} detail polygons in view");
     assert_light_agree(&scene, &reference(&scene), &lone.frame, "lone sheets against ray-cast");
     assert_light_agree(&scene, &reference(&scene), &floor_meets.frame, "no backgrounds against ray-cast");
@@ -731,7 +742,7 @@ fn merged_volumes_leave_out_closed_solids_turned_away() {
         let options = VolumeOptions { counting: Counting::ZFail, construction, ..Default::default() };
         let out =
             umbra::render(&scene, &umbra::RenderOptions { shadows: ShadowMethod::Crow(options), ..Default::default() });
-        out.unwrap().stats.shadow_counters.get("shadow_polygons_front_cap")
+        out.unwrap().stats.shadow_counters.get(umbra::Counter::ShadowPolygonsFrontCap)
     };
     let (merged, apart) = (caps(true), caps(false));
     assert!(merged * 10 < apart * 6 && merged * 10 > apart * 4, "{merged} caps merged, {apart} apart");
@@ -756,10 +767,14 @@ fn neighbours_behind_their_receiver_are_never_projected() {
         let opts =
             umbra::RenderOptions { shadows: ShadowMethod::BouknightKelley(Default::default()), ..Default::default() };
         let c = umbra::render(&scene, &opts).unwrap().stats.shadow_counters;
-        let kept = c.get("pairs_kept_by_prefilter");
+        let kept = c.get(umbra::Counter::PairsKeptByPrefilter);
         assert!(kept > 0, "level {levels}: the prefilter kept no neighbours");
-        assert_eq!(c.get("pairs_dropped_behind"), kept, "level {levels}: a neighbour was not dropped as behind");
-        assert_eq!(c.get("shadow_polygons"), 0, "level {levels}");
+        assert_eq!(
+            c.get(umbra::Counter::PairsDroppedBehind),
+            kept,
+            "level {levels}: a neighbour was not dropped as behind"
+        );
+        assert_eq!(c.get(umbra::Counter::ShadowPolygons), 0, "level {levels}");
     }
 }
 
@@ -794,10 +809,10 @@ fn neighbours_in_the_receivers_plane_are_never_projected() {
     let opts =
         umbra::RenderOptions { shadows: ShadowMethod::BouknightKelley(Default::default()), ..Default::default() };
     let c = umbra::render(&scene, &opts).unwrap().stats.shadow_counters;
-    assert_eq!(c.get("pairs_kept_by_prefilter"), 7 * 6);
-    assert!(c.get("pairs_outside_receiver") > 0, "no neighbour was found beside its receiver");
-    assert_eq!(c.get("projections_empty"), 0);
-    assert_eq!(c.get("shadow_polygons"), 0);
+    assert_eq!(c.get(umbra::Counter::PairsKeptByPrefilter), 7 * 6);
+    assert!(c.get(umbra::Counter::PairsOutsideReceiver) > 0, "no neighbour was found beside its receiver");
+    assert_eq!(c.get(umbra::Counter::ProjectionsEmpty), 0);
+    assert_eq!(c.get(umbra::Counter::ShadowPolygons), 0);
 }
 
 /// Z-fail's volumes are closed at a far plane where every sight line through the scene's
@@ -817,7 +832,8 @@ fn zfail_closes_its_volumes_at_a_far_plane_or_at_infinity() {
             let opts = umbra::RenderOptions { shadows: m.clone(), ..Default::default() };
             let out = umbra::render(scene, &opts).unwrap();
             let c = &out.stats.shadow_counters;
-            let (far_caps, back_caps) = (c.get("shadow_polygons_far_cap"), c.get("shadow_polygons_back_cap"));
+            let (far_caps, back_caps) =
+                (c.get(umbra::Counter::ShadowPolygonsFarCap), c.get(umbra::Counter::ShadowPolygonsBackCap));
             assert_eq!((far_caps > 0, back_caps > 0), (far, !far), "far caps {far_caps}, back caps {back_caps}");
             assert_light_agree(scene, &reference(scene), &out.frame, &format!("{m:?} closed far: {far}"));
         }
@@ -853,7 +869,7 @@ fn area_lights_have_an_umbra_and_a_penumbra() {
     }
     assert!(umbra > 100 && penumbra > 100, "{umbra} umbra, {penumbra} penumbra pixels");
     let c = &out.stats.shadow_counters;
-    assert_eq!((c.get("umbra_pixels"), c.get("penumbra_pixels")), (umbra, penumbra));
+    assert_eq!((c.get(umbra::Counter::UmbraPixels), c.get(umbra::Counter::PenumbraPixels)), (umbra, penumbra));
 }
 
 /// The exact lit fraction of an area light (`umbra::reference::exact_fraction`) on hand-made

@@ -28,7 +28,7 @@ fn random_scenes_agree_with_ray_cast() {
     for seed in 0..300 {
         let scene = random(seed, RandomOptions { width: 64, height: 48, ..RandomOptions::default() }).unwrap();
         let opts = umbra::RenderOptions { shadows: ShadowMethod::None, ..Default::default() };
-        splits += umbra::render(&scene, &opts).unwrap().stats.visibility_counters.get("span_splits");
+        splits += umbra::render(&scene, &opts).unwrap().stats.visibility_counters.get(umbra::Counter::SpanSplits);
         let view = umbra::view::View::new(scene.camera());
         clipped += (0..scene.polygons().len())
             .filter(|&i| scene.verts(i).iter().any(|&p| view.to_camera(p).z < scene.camera().near))
@@ -73,7 +73,7 @@ fn back_faces_of_closed_solids_are_left_out_and_nothing_seen_changes() {
             ..Default::default()
         };
         let r = umbra::render(scene, &opts).unwrap();
-        (r.stats.visibility_counters.get("screen_polygons"), r.frame)
+        (r.stats.visibility_counters.get(umbra::Counter::ScreenPolygons), r.frame)
     };
     let spheres = umbra::generate::spheres(2000, 4, 160, 90).unwrap();
     let reference = frame(&spheres, VisibilityMethod::RayCast, ShadowMethod::None);
