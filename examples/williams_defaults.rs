@@ -27,9 +27,9 @@ fn main() {
     .iter()
     .map(|n| (n.to_string(), Scene::load(root.join(format!("scenes/{n}.toml"))).unwrap()))
     .collect();
-    scenes.push(("bunny, 3 lights".into(), Scene::from_toml(&bunny(), &root.join("bunny.toml"), root).unwrap()));
+    scenes.push(("bunny, 3 lights".into(), Scene::from_toml(&bunny(), root.join("bunny.toml"), root).unwrap()));
     for (name, dir) in [("cards, overhead", [0.1, -1.0, 0.05]), ("cards, grazing", [1.0, -0.12, 0.3])] {
-        scenes.push((name.into(), Scene::from_toml(&cards(dir), &root.join("cards.toml"), root).unwrap()));
+        scenes.push((name.into(), Scene::from_toml(&cards(dir), root.join("cards.toml"), root).unwrap()));
     }
     let d = WilliamsOptions::default();
     let candidates: Vec<(&str, WilliamsOptions)> = vec![

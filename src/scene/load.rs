@@ -262,7 +262,8 @@ impl Scene {
 
     /// Parses scene text; `file` names it in errors and `dir` is where relative mesh paths
     /// start from.
-    pub fn from_toml(src: &str, file: &Path, dir: &Path) -> Result<Scene> {
+    pub fn from_toml(src: &str, file: impl AsRef<Path>, dir: impl AsRef<Path>) -> Result<Scene> {
+        let (file, dir) = (file.as_ref(), dir.as_ref());
         // A UTF-8 byte-order mark is not part of the first line.
         let src = src.strip_prefix('\u{feff}').unwrap_or(src);
         let src = &crate::scene::lone_cr_to_lf(src);

@@ -17,7 +17,8 @@ fn f3(v: Vec3) -> String {
 impl Scene {
     /// Writes the scene to `path` (a `.toml` file) with each object's mesh as an OBJ file in
     /// `meshes/` beside it, named after the scene file.
-    pub fn write(&self, path: &Path) -> Result<()> {
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
         let dir = path.parent().unwrap_or(Path::new(""));
         let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
         let meshes = dir.join("meshes");

@@ -1245,7 +1245,8 @@ impl ShadowDatabase {
     /// Writes the database as an OBJ file: one group per detail polygon, named after its
     /// light sample and the face id of its source polygon (`g sample<s>_face<id>`); holes are
     /// separate faces of the same group.
-    pub fn write_obj(&self, scene: &Scene, path: &Path) -> Result<()> {
+    pub fn write_obj(&self, scene: &Scene, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
         let mut obj = ObjText::with_header("# umbra: Atherton-Weiler-Greenberg lit detail polygons\n");
         for (s, polys) in self.samples.iter().enumerate() {
             for d in polys {

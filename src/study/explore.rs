@@ -436,7 +436,14 @@ fn point(value: &str) -> Result<DVec3> {
 
 /// Writes the page with every line of every applicable stage precomputed into `dir`, at
 /// `width` x `height`, for reading from disk or any static web host.
-pub fn export(explorer: &Explorer, dir: &Path, width: u32, height: u32, stages: &[ShadowMethod]) -> Result<()> {
+pub fn export(
+    explorer: &Explorer,
+    dir: impl AsRef<Path>,
+    width: u32,
+    height: u32,
+    stages: &[ShadowMethod],
+) -> Result<()> {
+    let dir = dir.as_ref();
     let io = |path: &Path, e: std::io::Error| Error::Write { path: path.to_owned(), source: e };
     let write = |name: &str, bytes: &[u8]| {
         let path = dir.join(name);

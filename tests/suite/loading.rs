@@ -57,7 +57,7 @@ fn bad_obj_line_names_the_obj_file() {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").unwrap();
     let src = format!("{CAMERA}[[object]]\nmesh = \"m.obj\"\n");
-    let e = Scene::from_toml(&src, &dir.join("s.toml"), &dir).unwrap_err().to_string();
+    let e = Scene::from_toml(&src, dir.join("s.toml"), &dir).unwrap_err().to_string();
     assert!(e.ends_with("m.obj:4: vertex index 4 out of range (3 defined so far)"), "{e}");
 }
 
