@@ -646,11 +646,11 @@ impl Scene {
             polygons_id: next_polygons_id(),
             bounds: None,
         };
-        scene.compile().map_err(Error::InvalidOption)?;
+        scene.compile()?;
         Ok(scene)
     }
 
-    fn compile(&mut self) -> std::result::Result<(), String> {
+    fn compile(&mut self) -> Result<()> {
         for (oi, obj) in self.objects.iter().enumerate() {
             let m = obj.transform.matrix();
             let nm = DMat3::from_mat4(m).inverse().transpose();
@@ -658,7 +658,10 @@ impl Scene {
             let world: Vec<DVec3> = mesh.positions.iter().map(|&p| m.transform_point3(p)).collect();
             if !world.iter().all(|p| p.is_finite()) {
                 let name = obj.name.as_deref().map_or(String::new(), |n| format!(" '{n}'"));
-                return Err(format!("object {oi}{name}: its transform takes vertices beyond the range of f64"));
+                return Err(Error::scene(
+                    format!("object {oi}{name}"),
+                    "its transform takes vertices beyond the range of f64",
+                ));
             }
             let vn: Vec<DVec3> = mesh.normals.iter().map(|&n| (nm * n).normalize_or_zero()).collect();
             // Averaged normals for faces without `vn`: area-weighted face normals summed over
