@@ -253,6 +253,54 @@ impl Default for VolumeOptions {
     }
 }
 
+/// Nishita and Nakamae's steps of ours, each with its switch (`docs/algorithms/nishita-nakamae.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct NishitaNakamaeOptions {
+    /// Leave out the casters outside the convex hull of a receiver and the light (a BVH
+    /// query), instead of taking every polygon as a possible occluder of every receiver.
+    pub hull_cull: bool,
+    /// Drop the polygons of closed solids that turn their back on the whole light.
+    pub solid_cull: bool,
+    /// Hide with one hull what a convex closed solid hides at a penumbra pixel, instead of
+    /// one shadow per polygon.
+    pub convex_bodies: bool,
+    /// Take no caster of a receiver's own convex solid (seen from outside, none can come
+    /// between it and the light).
+    pub same_solid: bool,
+    /// Where the papers' premise fails for a pair (the caster reaches as near the light as
+    /// its nearest corner, or the light is cut by the receiver's plane), take the caster as
+    /// an occluder of every pixel of the receiver. Off, the pair is left out as the premise
+    /// assumes it never arises: its shadow is missing (not exact).
+    pub premise_fallback: bool,
+}
+
+impl NishitaNakamaeOptions {
+    /// Every step of ours on.
+    pub const DEFAULT: NishitaNakamaeOptions = NishitaNakamaeOptions {
+        hull_cull: true,
+        solid_cull: true,
+        convex_bodies: true,
+        same_solid: true,
+        premise_fallback: true,
+    };
+
+    /// The papers as published: every polygon a possible occluder of every receiver, each
+    /// hiding on its own, the premise taken for granted.
+    pub const PAPER: NishitaNakamaeOptions = NishitaNakamaeOptions {
+        hull_cull: false,
+        solid_cull: false,
+        convex_bodies: false,
+        same_solid: false,
+        premise_fallback: false,
+    };
+}
+
+impl Default for NishitaNakamaeOptions {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
 /// Every stage's settings at once, as a command line or a notebook holds them;
 /// [`ShadowMethod::with_settings`] gives a method those of its own stage.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -265,6 +313,8 @@ pub struct StageSettings {
     pub volumes: VolumeOptions,
     /// Williams' shadow maps'.
     pub williams: WilliamsOptions,
+    /// Nishita and Nakamae's.
+    pub nishita_nakamae: NishitaNakamaeOptions,
 }
 
 /// What every shadow stage is prepared from.
@@ -546,7 +596,7 @@ pub enum ShadowMethod {
     Planar,
     /// Nishita & Nakamae's umbra and penumbra polygons from the light's corners, the
     /// penumbra's pixels by clipping the light: area lights' exact fraction.
-    NishitaNakamae,
+    NishitaNakamae(NishitaNakamaeOptions),
 }
 
 impl ShadowMethod {
@@ -563,7 +613,7 @@ impl ShadowMethod {
         ShadowMethod::Williams(WilliamsOptions::DEFAULT),
         ShadowMethod::StencilVolume(VolumeOptions::DEFAULT),
         ShadowMethod::Planar,
-        ShadowMethod::NishitaNakamae,
+        ShadowMethod::NishitaNakamae(NishitaNakamaeOptions::DEFAULT),
         ShadowMethod::RayCast,
     ];
 
@@ -578,7 +628,7 @@ impl ShadowMethod {
             ShadowMethod::Williams(_) => "williams",
             ShadowMethod::StencilVolume(_) => "stencil-volume",
             ShadowMethod::Planar => "planar",
-            ShadowMethod::NishitaNakamae => "nishita-nakamae",
+            ShadowMethod::NishitaNakamae(_) => "nishita-nakamae",
         }
     }
 
@@ -618,7 +668,7 @@ impl ShadowMethod {
                  of Crow's count, rasterised before the frame is shaded."
             }
             ShadowMethod::Planar => "Blinn (1988): shadows projected onto marked receiver planes. Approximate.",
-            ShadowMethod::NishitaNakamae => {
+            ShadowMethod::NishitaNakamae(_) => {
                 "Nishita & Nakamae (1983-85): umbra and penumbra polygons from the light's corners; pixels \
                  in an umbra are dark and outside every penumbra lit, a span at a time; only in the penumbra \
                  is the visible part of an area light clipped out and measured: its exact lit fraction."
@@ -653,11 +703,10 @@ impl ShadowMethod {
             ShadowMethod::StencilVolume(v) => {
                 ShadowMethod::StencilVolume(VolumeOptions { counting: v.counting, ..VolumeOptions::PAPER })
             }
-            ShadowMethod::None
-            | ShadowMethod::RayCast
-            | ShadowMethod::Williams(_)
-            | ShadowMethod::Planar
-            | ShadowMethod::NishitaNakamae => self.clone(),
+            ShadowMethod::NishitaNakamae(_) => ShadowMethod::NishitaNakamae(NishitaNakamaeOptions::PAPER),
+            ShadowMethod::None | ShadowMethod::RayCast | ShadowMethod::Williams(_) | ShadowMethod::Planar => {
+                self.clone()
+            }
         }
     }
 
@@ -683,9 +732,8 @@ impl ShadowMethod {
             ShadowMethod::Crow(_) => ShadowMethod::Crow(settings.volumes),
             ShadowMethod::StencilVolume(_) => ShadowMethod::StencilVolume(settings.volumes),
             ShadowMethod::Williams(_) => ShadowMethod::Williams(settings.williams.clone()),
-            ShadowMethod::None | ShadowMethod::RayCast | ShadowMethod::Planar | ShadowMethod::NishitaNakamae => {
-                self.clone()
-            }
+            ShadowMethod::NishitaNakamae(_) => ShadowMethod::NishitaNakamae(settings.nishita_nakamae),
+            ShadowMethod::None | ShadowMethod::RayCast | ShadowMethod::Planar => self.clone(),
         }
     }
 
@@ -718,12 +766,19 @@ impl ShadowMethod {
             ShadowMethod::StencilVolume(v) => {
                 out.push(ShadowMethod::StencilVolume(VolumeOptions { counting: volumes::Counting::ZFail, ..*v }));
             }
+            ShadowMethod::NishitaNakamae(o) => {
+                // Each step that buys speed off by itself (the premise's fallback is what
+                // keeps the stage exact: it goes with the paper path).
+                out.push(ShadowMethod::NishitaNakamae(NishitaNakamaeOptions { hull_cull: false, ..*o }));
+                out.push(ShadowMethod::NishitaNakamae(NishitaNakamaeOptions { solid_cull: false, ..*o }));
+                out.push(ShadowMethod::NishitaNakamae(NishitaNakamaeOptions { convex_bodies: false, ..*o }));
+                out.push(ShadowMethod::NishitaNakamae(NishitaNakamaeOptions { same_solid: false, ..*o }));
+            }
             ShadowMethod::AthertonWeilerGreenberg(_)
             | ShadowMethod::None
             | ShadowMethod::RayCast
             | ShadowMethod::Williams(_)
-            | ShadowMethod::Planar
-            | ShadowMethod::NishitaNakamae => {}
+            | ShadowMethod::Planar => {}
         }
         let paper = self.as_published();
         if self.has_paper_path() && !out.contains(&paper) {
@@ -746,7 +801,7 @@ impl ShadowMethod {
             | ShadowMethod::RayCast
             | ShadowMethod::Williams(_)
             | ShadowMethod::StencilVolume(_)
-            | ShadowMethod::NishitaNakamae => false,
+            | ShadowMethod::NishitaNakamae(_) => false,
         }
     }
 
@@ -756,7 +811,7 @@ impl ShadowMethod {
     /// others against ray-cast.
     pub fn exact_area_fraction(&self) -> bool {
         match self {
-            ShadowMethod::NishitaNakamae => true,
+            ShadowMethod::NishitaNakamae(_) => true,
             ShadowMethod::None
             | ShadowMethod::RayCast
             | ShadowMethod::BouknightKelley(_)
@@ -811,7 +866,15 @@ impl ShadowMethod {
                 }
             }
             ShadowMethod::Williams(o) => on.extend(o.flags().into_iter().map(|f| (true, f))),
-            ShadowMethod::None | ShadowMethod::RayCast | ShadowMethod::Planar | ShadowMethod::NishitaNakamae => {}
+            ShadowMethod::NishitaNakamae(_) if paper => {}
+            ShadowMethod::NishitaNakamae(o) => {
+                on.push((!o.hull_cull, "--no-hull-cull".into()));
+                on.push((!o.solid_cull, "--no-solid-cull".into()));
+                on.push((!o.convex_bodies, "--no-convex-bodies".into()));
+                on.push((!o.same_solid, "--no-same-solid".into()));
+                on.push((!o.premise_fallback, "--no-premise-fallback".into()));
+            }
+            ShadowMethod::None | ShadowMethod::RayCast | ShadowMethod::Planar => {}
         }
         let mut flags = vec![self.name().to_string()];
         flags.extend(on.into_iter().filter(|(set, _)| *set).map(|(_, f)| f));
@@ -832,6 +895,7 @@ impl ShadowMethod {
                 | ShadowMethod::AthertonWeilerGreenberg(_)
                 | ShadowMethod::Crow(_)
                 | ShadowMethod::StencilVolume(_)
+                | ShadowMethod::NishitaNakamae(_)
         )
     }
 
@@ -857,10 +921,8 @@ impl ShadowMethod {
                     && v.construction != Construction::Crow1977
                     && (v.sight_cuts || v.counting != volumes::Counting::ZFail)
             }
-            ShadowMethod::RayCast
-            | ShadowMethod::BouknightKelley(_)
-            | ShadowMethod::AthertonWeilerGreenberg(_)
-            | ShadowMethod::NishitaNakamae => true,
+            ShadowMethod::NishitaNakamae(o) => o.premise_fallback,
+            ShadowMethod::RayCast | ShadowMethod::BouknightKelley(_) | ShadowMethod::AthertonWeilerGreenberg(_) => true,
         }
     }
 
@@ -879,7 +941,7 @@ impl ShadowMethod {
             ShadowMethod::Williams(o) => Box::new(Williams::new(ctx, o, counters)?),
             ShadowMethod::StencilVolume(o) => Box::new(StencilVolume::new(ctx, *o, counters)?),
             ShadowMethod::Planar => Box::new(Planar::new(ctx, counters)?),
-            ShadowMethod::NishitaNakamae => Box::new(NishitaNakamae::new(ctx, counters)),
+            ShadowMethod::NishitaNakamae(o) => Box::new(NishitaNakamae::new(ctx, *o, counters)),
         })
     }
 }

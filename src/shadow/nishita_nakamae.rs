@@ -37,7 +37,7 @@
 
 use super::overlay::{Interval, Overlay, OverlayWalker, ReceiverTable};
 use super::projection::{bounding_rectangle, edge_on, Projector, Target};
-use super::{Decision, ShadowContext, ShadowStage, ShadowWalker};
+use super::{Decision, NishitaNakamaeOptions, ShadowContext, ShadowStage, ShadowWalker};
 use crate::bvh::Bvh;
 use crate::geometry::convex_split::is_convex;
 use crate::geometry::{clip_polygon, Plane};
@@ -378,7 +378,7 @@ struct OnReceiver {
 
 impl<'a> NishitaNakamae<'a> {
     /// Steps 1 to 3 for every light and receiver.
-    pub(crate) fn new(ctx: &'a ShadowContext<'a>, counters: &mut Counters) -> Self {
+    pub(crate) fn new(ctx: &'a ShadowContext<'a>, options: NishitaNakamaeOptions, counters: &mut Counters) -> Self {
         let scene = ctx.scene;
         let n = scene.polygons.len() as u32;
         let casters = Bvh::new(scene, (0..n).filter(|&i| scene.casts_shadows(i as usize)).collect());
@@ -395,11 +395,12 @@ impl<'a> NishitaNakamae<'a> {
                     Source::Area(area) => area.closed_solids(scene),
                     Source::Vertex => Vec::new(),
                 };
+                let solids = Solids { closed: &closed, convex: &convex, options };
                 let per: Vec<(u32, OnReceiver)> = receivers
                     .par_iter()
-                    .map(|&b| (b, on_receiver(ctx, &casters, &source, sample, &closed, b)))
+                    .map(|&b| (b, on_receiver(ctx, &casters, &source, sample, &solids, b)))
                     .collect();
-                let bodies = closed.iter().zip(&convex).map(|(&c, &v)| c && v).collect();
+                let bodies = closed.iter().zip(&convex).map(|(&c, &v)| c && v && options.convex_bodies).collect();
                 gather(ctx, source, per, bodies, counters)
             })
             .collect();
@@ -445,13 +446,32 @@ fn gather(
     LightShadows { source, umbra, penumbra, occluder, everywhere, bodies }
 }
 
+/// What steps 1 to 3 know of the scene's solids, and the switches of the steps of ours.
+struct Solids<'s> {
+    /// `closed[s]`: solid `s` is closed from the whole light (area lights only).
+    closed: &'s [bool],
+    /// `convex[s]`: solid `s` is convex.
+    convex: &'s [bool],
+    options: NishitaNakamaeOptions,
+}
+
+impl Solids<'_> {
+    /// Whether caster `a` is left out for receiver `b` by a step of ours: its solid turns
+    /// its back on the whole light (`corners`), or it belongs to `b`'s own convex solid.
+    fn skip(&self, ctx: &ShadowContext, corners: Option<&[DVec3; 4]>, a: u32, b: u32) -> bool {
+        let o = &self.options;
+        (o.solid_cull && corners.is_some_and(|c| turned_away(ctx.scene, self.closed, c, a)))
+            || (o.same_solid && same_convex_solid(ctx, self.convex, a, b))
+    }
+}
+
 /// Steps 1 to 3 on receiver `b`.
 fn on_receiver(
     ctx: &ShadowContext,
     casters: &Bvh,
     source: &Source,
     sample: Option<LightSample>,
-    closed: &[bool],
+    solids: &Solids,
     b: u32,
 ) -> OnReceiver {
     let scene = ctx.scene;
@@ -476,7 +496,9 @@ fn on_receiver(
                 LightSample::Point(s) => Some(s),
                 LightSample::Directional(_) => None,
             };
-            for a in candidates(scene, casters, b_verts, reach.as_slice(), face, |_| false, ctx.extent) {
+            let skip = |a: u32| solids.skip(ctx, None, a, b);
+            let hull = solids.options.hull_cull;
+            for a in candidates(scene, casters, b_verts, reach.as_slice(), face, skip, hull, ctx.extent) {
                 r.pairs += 1;
                 if edge_on(scene, a as usize, sample, ctx.extent) || !proj.project(scene.verts(a as usize), &target) {
                     continue;
@@ -486,7 +508,7 @@ fn on_receiver(
                 }
             }
         }
-        (Source::Area(light), _) => area_on_receiver(ctx, casters, light, closed, b, &mut r),
+        (Source::Area(light), _) => area_on_receiver(ctx, casters, light, solids, b, &mut r),
         (Source::Vertex, None) => {}
     }
     r.umbra.finish();
@@ -499,7 +521,7 @@ fn area_on_receiver(
     ctx: &ShadowContext,
     casters: &Bvh,
     light: &AreaLight,
-    closed: &[bool],
+    solids: &Solids,
     b: u32,
     r: &mut OnReceiver,
 ) {
@@ -525,8 +547,9 @@ fn area_on_receiver(
     let mut everywhere = Vec::new();
     let (mut points, mut hull, mut a2, mut b2) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut part = Vec::new();
-    let skip = |a: u32| turned_away(scene, closed, &lv, a);
-    for a in candidates(scene, casters, b_verts, &lv, polygon.face, skip, ctx.extent) {
+    let skip = |a: u32| solids.skip(ctx, Some(&lv), a, b);
+    let cull = solids.options.hull_cull;
+    for a in candidates(scene, casters, b_verts, &lv, polygon.face, skip, cull, ctx.extent) {
         r.pairs += 1;
         let whole = scene.verts(a as usize);
         if whole.iter().all(|&o| seen * plane.distance(o) <= 0.0) {
@@ -537,7 +560,10 @@ fn area_on_receiver(
         let verts = &part[..];
         let d: smallvec::SmallVec<[f64; 8]> = verts.iter().map(|&o| (seen * plane.distance(o)).max(0.0)).collect();
         if cut || d.iter().any(|&h| h >= nearest) {
-            everywhere.push(a); // the premise fails: step 5 takes it at every pixel
+            // The premise fails: step 5 takes it at every pixel (ours), or it is left out.
+            if solids.options.premise_fallback {
+                everywhere.push(a);
+            }
             continue;
         }
         // Step 2: the hull of the projections of O's vertices from the light's vertices.
@@ -590,9 +616,10 @@ fn area_on_receiver(
 
 /// The casters (not of face `face`, not `skip`ped) that can cross a segment from receiver
 /// `verts` to a point of `reach` (the light's corners; every caster when the light has no
-/// position). Ours: a caster is left out when it lies wholly outside one face of the convex
-/// hull of the receiver and the light, which holds every such segment (found in the BVH,
-/// then polygon by polygon).
+/// position). Ours, when `hull`: a caster is left out when it lies wholly outside one face of
+/// the convex hull of the receiver and the light, which holds every such segment (found in
+/// the BVH, then polygon by polygon); without it, every caster.
+#[allow(clippy::too_many_arguments)]
 fn candidates(
     scene: &Scene,
     casters: &Bvh,
@@ -600,11 +627,12 @@ fn candidates(
     reach: &[DVec3],
     face: u32,
     skip: impl Fn(u32) -> bool,
+    hull: bool,
     extent: f64,
 ) -> Vec<u32> {
     let mut out = Vec::new();
     let keep = |i: u32| scene.polygons[i as usize].face != face && !skip(i);
-    if reach.is_empty() {
+    if reach.is_empty() || !hull {
         casters.each(|i| {
             if keep(i) {
                 out.push(i)
@@ -673,6 +701,21 @@ fn hull_planes(points: &[DVec3], margin: f64) -> Vec<(DVec3, f64)> {
 /// solid cull, `Scene::turned_away_on_solid`).
 fn turned_away(scene: &Scene, closed: &[bool], corners: &[DVec3; 4], a: u32) -> bool {
     corners.iter().all(|&c| scene.turned_away_on_solid(a as usize, LightSample::Point(c), closed))
+}
+
+/// Whether caster `a` is a polygon of the convex solid that receiver `b` belongs to, `b` seen
+/// from outside (ours): every polygon of the solid lies on or behind `b`'s plane, and a
+/// segment from a point of `b` to a point of the light in front of it lies in front of that
+/// plane but for its end on `b`, so no polygon of the solid can cross it. (A sphere's
+/// triangles near its terminator, whose neighbours rise above their plane by rounding alone,
+/// are the receivers this spares.)
+fn same_convex_solid(ctx: &ShadowContext, convex: &[bool], a: u32, b: u32) -> bool {
+    let scene = ctx.scene;
+    let s = scene.solid_of[b as usize];
+    let (Some(true), Some(solid)) = (convex.get(s as usize), scene.solids.get(s as usize)) else {
+        return false;
+    };
+    scene.solid_of[a as usize] == s && solid.sign * scene.polygons[b as usize].plane.distance(ctx.view.eye) > 0.0
 }
 
 /// Coordinates in a plane: an origin and two unit axes across its normal.

@@ -9,7 +9,7 @@ use umbra::generate::{random, RandomOptions};
 use umbra::scene::LightKind;
 use umbra::{Scene, ShadowMethod, VisibilityMethod};
 
-const NN: ShadowMethod = ShadowMethod::NishitaNakamae;
+const NN: ShadowMethod = ShadowMethod::NishitaNakamae(umbra::shadow::NishitaNakamaeOptions::DEFAULT);
 
 /// The lights of `scene` that are not area lights.
 fn point_lights(scene: &Scene) -> Vec<usize> {
@@ -18,14 +18,68 @@ fn point_lights(scene: &Scene) -> Vec<usize> {
 
 /// Checks the stage on `scene`; returns the area-light pixels compared and those in the penumbra.
 fn check(scene: &Scene, label: &str) -> (usize, usize) {
+    check_stage(scene, label, &NN)
+}
+
+/// [`check`] with the stage's settings `stage`.
+fn check_stage(scene: &Scene, label: &str, stage: &ShadowMethod) -> (usize, usize) {
     let want = frame(scene, VisibilityMethod::RayCast, ShadowMethod::RayCast);
     let mut area = (0, 0);
     for v in [VisibilityMethod::Scanline, VisibilityMethod::ZBuffer] {
-        let got = frame(scene, v, NN);
-        assert_lights_agree(scene, &want, &got, &format!("{label} behind {v}"), &point_lights(scene));
-        area = assert_area_exact(scene, &got, &format!("{label} behind {v}"));
+        let got = frame(scene, v, stage.clone());
+        let label = format!("{label} {} behind {v}", stage.command_line());
+        assert_lights_agree(scene, &want, &got, &label, &point_lights(scene));
+        area = assert_area_exact(scene, &got, &label);
     }
     area
+}
+
+/// Each step of ours off by itself (`ShadowMethod::variants`) leaves the stage exact: on the
+/// example scenes and a few random ones.
+#[test]
+fn each_step_of_ours_off_leaves_the_fraction_exact() {
+    let variants: Vec<ShadowMethod> = NN.variants().into_iter().skip(1).filter(ShadowMethod::is_exact).collect();
+    assert_eq!(variants.len(), 4, "{variants:?}");
+    for stage in &variants {
+        for path in scene_files() {
+            check_stage(&load_scaled(&path, 96), &path.display().to_string(), stage);
+        }
+        for seed in 0..8 {
+            let scene = random(seed, RandomOptions { width: 48, height: 36, ..RandomOptions::default() }).unwrap();
+            check_stage(&scene, &format!("random scene {seed}"), stage);
+        }
+    }
+}
+
+/// The paper path (every step of ours off, the premise taken for granted) is exact where the
+/// premise holds (the lights scene), and fails where it does not: a card above the nearest
+/// corner of a tilted light casts no shadow there, and the floor under it reads lit where
+/// the exact fraction is not.
+#[test]
+fn the_paper_path_fails_only_where_its_premise_does() {
+    let paper = NN.as_published();
+    assert!(paper.is_paper() && !paper.is_exact());
+    let scene = load_scaled(&std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/lights.toml")), 96);
+    check_stage(&scene, "lights", &paper);
+
+    let src = "[camera]\neye = [0.0, 6.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\nwidth = 64\nheight = 48\n\
+               [[light]]\nkind = \"area\"\ncorner = [-0.5, 1.5, -0.5]\nedge_u = [1.0, 1.0, 0.0]\nedge_v = [0.0, 0.0, 1.0]\nsamples = [4, 4]\n\
+               [[object]]\npolygons = [[[-4.0, 0.0, -4.0], [-4.0, 0.0, 4.0], [4.0, 0.0, 4.0], [4.0, 0.0, -4.0]]]\n\
+               [[object]]\npolygons = [[[0.2, 1.8, -0.3], [0.2, 1.8, 0.3], [0.8, 1.8, 0.3], [0.8, 1.8, -0.3]]]\n";
+    let scene = Scene::from_toml(src, "tilted.toml", ".").unwrap();
+    let oracle = umbra::reference::Reference::new(&scene);
+    let (exact, published) =
+        (frame(&scene, VisibilityMethod::Scanline, NN), frame(&scene, VisibilityMethod::Scanline, paper));
+    assert_area_exact(&scene, &exact, "tilted light, nishita-nakamae");
+    let mut missing = 0;
+    for (k, (&got, &id)) in published.light[0].iter().zip(&published.id).enumerate() {
+        let (x, y) = ((k % 64) as f64 + 0.5, (k / 64) as f64 + 0.5);
+        let want = oracle.exact_fraction_at(0, x, y);
+        if id == 0 && want.is_some_and(|w| w < 0.9) && got == 1.0 {
+            missing += 1;
+        }
+    }
+    assert!(missing > 20, "{missing} floor pixels lit by the paper path where the card hides the light");
 }
 
 #[test]

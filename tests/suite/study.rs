@@ -278,7 +278,7 @@ fn the_samples_sweep_measures_the_grid_against_the_exact_fraction() {
     let out = tmp("scale-samples");
     let methods = vec![
         (umbra::VisibilityMethod::Scanline, ShadowMethod::Crow(Default::default())),
-        (umbra::VisibilityMethod::Scanline, ShadowMethod::NishitaNakamae),
+        (umbra::VisibilityMethod::Scanline, ShadowMethod::NishitaNakamae(Default::default())),
     ];
     let opts = umbra::study::scale::ScaleOptions {
         sweep: Sweep::Samples,

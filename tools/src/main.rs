@@ -12,8 +12,8 @@ use std::sync::atomic::{AtomicBool, AtomicIsize, Ordering::Relaxed};
 use std::sync::Arc;
 use umbra::shadow::Counting;
 use umbra::shadow::{
-    AthertonWeilerGreenbergOptions, BouknightKelleyOptions, Construction, ShadowFilter, StageSettings, VolumeOptions,
-    WilliamsOptions,
+    AthertonWeilerGreenbergOptions, BouknightKelleyOptions, Construction, NishitaNakamaeOptions, ShadowFilter,
+    StageSettings, VolumeOptions, WilliamsOptions,
 };
 use umbra::study::compare::{compare, CompareOptions};
 use umbra::study::scale::{scale, ScaleOptions, Sweep};
@@ -227,11 +227,29 @@ struct ShadowArgs {
     /// as the paper does, instead of dropping them first (ours).
     #[arg(long)]
     no_wedge: bool,
-    /// Bouknight-Kelley and Atherton-Weiler-Greenberg: keep the polygons of closed solids
-    /// that face away from the light (as casters; in AWG's light views), as the papers do (to
-    /// measure what dropping them saves).
+    /// Bouknight-Kelley, Atherton-Weiler-Greenberg and Nishita-Nakamae: keep the polygons of
+    /// closed solids that face away from the light (as casters; in AWG's light views), as the
+    /// papers do (to measure what dropping them saves).
     #[arg(long)]
     no_solid_cull: bool,
+    /// Nishita-Nakamae: take every polygon as a possible occluder of every receiver, as the
+    /// papers do, instead of those within the hull of the receiver and the light (ours).
+    #[arg(long)]
+    no_hull_cull: bool,
+    /// Nishita-Nakamae: each polygon of a convex solid hides on its own at a penumbra pixel,
+    /// instead of the solid as one hull (ours).
+    #[arg(long)]
+    no_convex_bodies: bool,
+    /// Nishita-Nakamae: take the polygons of a receiver's own convex solid as casters too
+    /// (ours leaves them out: none can come between it and the light).
+    #[arg(long)]
+    no_same_solid: bool,
+    /// Nishita-Nakamae: leave out a caster for which the papers' premise fails (it reaches
+    /// as near the light as its nearest corner, or the light is cut by the receiver's plane),
+    /// as the papers assume it never arises, instead of taking it at every pixel (ours; off,
+    /// the stage is not exact).
+    #[arg(long)]
+    no_premise_fallback: bool,
     #[command(flatten)]
     awg: AwgFlags,
     /// Crow and stencil-volume: count shadow volumes from the eye with the eye's own count
@@ -361,6 +379,13 @@ impl ShadowArgs {
                 filter,
                 cull_front: self.cull_front,
                 fit_to_view: !self.no_fit,
+            },
+            nishita_nakamae: NishitaNakamaeOptions {
+                hull_cull: !self.no_hull_cull,
+                solid_cull: !self.no_solid_cull,
+                convex_bodies: !self.no_convex_bodies,
+                same_solid: !self.no_same_solid,
+                premise_fallback: !self.no_premise_fallback,
             },
         };
         method.with_settings(&settings)
