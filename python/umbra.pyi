@@ -49,8 +49,15 @@ def render(
     shadows: str = "bouknight-kelley",
     paper: bool = False,
     gamma: Optional[float] = 2.2,
+    **settings: object,
 ) -> Frame:
-    """Renders the scene with a visibility and a shadow stage (paper=True: as published)."""
+    """Renders the scene with a visibility and a shadow stage (paper=True: as published).
+    Keyword settings set the stage's options by their names in the engine: prefilter,
+    sphere_grid, seen_receivers, drop_behind, wedge, solid_cull, convex_split, backgrounds,
+    lone_sheets, tiling, face_binning, sort_grid, counting ("zpass", "zfail", "naive-zpass"),
+    construction ("merged", "per-polygon", "crow-1977"), sight_cuts, map_size, bias,
+    slope_bias, normal_offset, receiver_plane, cull_front, fit_to_view, hull_cull,
+    convex_bodies, same_solid, premise_fallback."""
 
 def bench(
     scene: Scene,
@@ -59,6 +66,7 @@ def bench(
     runs: int = 5,
     warmup: int = 1,
     paper: bool = False,
+    **settings: object,
 ) -> List[Dict[str, object]]:
     """Times every pair of stages: one dict per pair (median_ms, min_ms, max_ms, times_ms,
     phases, counters)."""

@@ -101,14 +101,99 @@ impl Frame {
 }
 
 /// The options of one render from the Python arguments.
-fn options(visibility: &str, shadows: &str, paper: bool) -> PyResult<um::RenderOptions> {
+fn options(
+    visibility: &str,
+    shadows: &str,
+    paper: bool,
+    settings: Option<&Bound<'_, PyDict>>,
+) -> PyResult<um::RenderOptions> {
+    let method: um::ShadowMethod = shadows.parse().map_err(error)?;
     let opts = um::RenderOptions {
         visibility: visibility.parse().map_err(error)?,
-        shadows: shadows.parse().map_err(error)?,
+        shadows: method.with_settings(&stage_settings(settings)?),
         ..Default::default()
     };
     Ok(if paper { opts.as_published() } else { opts })
 }
+
+/// The stages' settings from keyword arguments, each named as its field in the engine's
+/// options (`prefilter=False`, `counting="zfail"`, `map_size=1024`); a setting names the
+/// same field of every stage that has it (`solid_cull`). Unknown names are refused with the
+/// known ones.
+fn stage_settings(settings: Option<&Bound<'_, PyDict>>) -> PyResult<um::shadow::StageSettings> {
+    let mut s = um::shadow::StageSettings::default();
+    let Some(settings) = settings else { return Ok(s) };
+    for (key, value) in settings.iter() {
+        let key: String = key.extract()?;
+        let flag = || value.extract::<bool>();
+        let (bk, awg, nn) = (&mut s.bouknight_kelley, &mut s.atherton_weiler_greenberg, &mut s.nishita_nakamae);
+        match key.as_str() {
+            "prefilter" => bk.prefilter = flag()?,
+            "sphere_grid" => bk.sphere_grid = flag()?,
+            "seen_receivers" => bk.seen_receivers = flag()?,
+            "drop_behind" => bk.drop_behind = flag()?,
+            "wedge" => bk.wedge = flag()?,
+            "solid_cull" => (bk.solid_cull, awg.solid_cull, nn.solid_cull) = (flag()?, flag()?, flag()?),
+            "convex_split" => awg.convex_split = flag()?,
+            "backgrounds" => awg.backgrounds = flag()?,
+            "lone_sheets" => awg.lone_sheets = flag()?,
+            "tiling" => awg.tiling = flag()?,
+            "face_binning" => awg.face_binning = flag()?,
+            "sort_grid" => awg.sort_grid = flag()?,
+            "counting" => s.volumes.counting = value.extract::<String>()?.parse().map_err(error)?,
+            "construction" => s.volumes.construction = value.extract::<String>()?.parse().map_err(error)?,
+            "sight_cuts" => s.volumes.sight_cuts = flag()?,
+            "map_size" => s.williams.map_size = value.extract()?,
+            "bias" => s.williams.bias = value.extract()?,
+            "slope_bias" => s.williams.slope_bias = value.extract()?,
+            "normal_offset" => s.williams.normal_offset = value.extract()?,
+            "receiver_plane" => s.williams.receiver_plane = flag()?,
+            "cull_front" => s.williams.cull_front = flag()?,
+            "fit_to_view" => s.williams.fit_to_view = flag()?,
+            "hull_cull" => nn.hull_cull = flag()?,
+            "convex_bodies" => nn.convex_bodies = flag()?,
+            "same_solid" => nn.same_solid = flag()?,
+            "premise_fallback" => nn.premise_fallback = flag()?,
+            _ => {
+                return Err(UmbraError::new_err(format!(
+                    "unknown stage setting '{key}' (known: {})",
+                    SETTINGS.join(", ")
+                )))
+            }
+        }
+    }
+    Ok(s)
+}
+
+/// The keyword arguments [`stage_settings`] knows.
+const SETTINGS: [&str; 26] = [
+    "prefilter",
+    "sphere_grid",
+    "seen_receivers",
+    "drop_behind",
+    "wedge",
+    "solid_cull",
+    "convex_split",
+    "backgrounds",
+    "lone_sheets",
+    "tiling",
+    "face_binning",
+    "sort_grid",
+    "counting",
+    "construction",
+    "sight_cuts",
+    "map_size",
+    "bias",
+    "slope_bias",
+    "normal_offset",
+    "receiver_plane",
+    "cull_front",
+    "fit_to_view",
+    "hull_cull",
+    "convex_bodies",
+    "same_solid",
+    "premise_fallback",
+];
 
 /// Loads a scene file (`docs/scene-format.md`). Raises `UmbraError` naming the file and
 /// line of a problem, `OSError`-like failures included.
@@ -120,10 +205,12 @@ fn load(path: PathBuf) -> PyResult<Scene> {
 /// Renders `scene` with the visibility stage `visibility` (`scanline`, `zbuffer`,
 /// `ray-cast`) and the shadow stage `shadows` (`bouknight-kelley`, `crow`,
 /// `atherton-weiler-greenberg`, `nishita-nakamae`, `williams`, `stencil-volume`, `planar`,
-/// `ray-cast`, `none`); `paper=True` runs the stage as its paper publishes it. `gamma`
-/// encodes the image (None: linear). The engine runs without the GIL, on every core.
+/// `ray-cast`, `none`); `paper=True` runs the stage as its paper publishes it, and keyword
+/// settings set the stage's options by their names in the engine (`prefilter=False`,
+/// `counting="zfail"`, `map_size=1024`, `same_solid=False`). `gamma` encodes the image
+/// (None: linear). The engine runs without the GIL, on every core.
 #[pyfunction]
-#[pyo3(signature = (scene, visibility = "scanline", shadows = "bouknight-kelley", paper = false, gamma = Some(2.2)))]
+#[pyo3(signature = (scene, visibility = "scanline", shadows = "bouknight-kelley", paper = false, gamma = Some(2.2), **settings))]
 fn render(
     py: Python<'_>,
     scene: &Scene,
@@ -131,8 +218,9 @@ fn render(
     shadows: &str,
     paper: bool,
     gamma: Option<f32>,
+    settings: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Frame> {
-    let opts = options(visibility, shadows, paper)?;
+    let opts = options(visibility, shadows, paper, settings)?;
     let rendered = py.allow_threads(|| um::render(&scene.inner, &opts)).map_err(error)?;
     frame(py, &rendered, gamma)
 }
@@ -178,9 +266,11 @@ fn times(py: Python<'_>, stats: &um::Stats) -> PyResult<Py<PyDict>> {
 /// Times every pair of `visibility` and `shadows` stages on `scene`: `warmup` renders
 /// untimed, then `runs` timed. Returns one dict per pair: `visibility`, `shadows` (the
 /// stage's label), `median_ms`, `min_ms`, `max_ms`, `times_ms` (each run's frame), `phases`
-/// (each phase's median, ms) and `counters` (the last run's).
+/// (each phase's median, ms) and `counters` (the last run's). Keyword settings as
+/// `render`'s, for every stage.
 #[pyfunction(name = "bench")]
-#[pyo3(signature = (scene, shadows = vec!["bouknight-kelley".to_string()], visibility = vec!["scanline".to_string()], runs = 5, warmup = 1, paper = false))]
+#[pyo3(signature = (scene, shadows = vec!["bouknight-kelley".to_string()], visibility = vec!["scanline".to_string()], runs = 5, warmup = 1, paper = false, **settings))]
+#[allow(clippy::too_many_arguments)]
 fn bench_stages(
     py: Python<'_>,
     scene: &Scene,
@@ -189,6 +279,7 @@ fn bench_stages(
     runs: usize,
     warmup: usize,
     paper: bool,
+    settings: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Vec<Py<PyDict>>> {
     if runs == 0 {
         return Err(UmbraError::new_err("bench: runs must be at least 1"));
@@ -196,7 +287,7 @@ fn bench_stages(
     let mut rows = Vec::new();
     for v in &visibility {
         for s in &shadows {
-            let opts = options(v, s, paper)?;
+            let opts = options(v, s, paper, settings)?;
             let timed = py
                 .allow_threads(|| {
                     let mut renderer = um::Renderer::new();

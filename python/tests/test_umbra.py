@@ -66,3 +66,21 @@ def test_bench_returns_rows(scene):
     for r in rows:
         assert r["min_ms"] <= r["median_ms"] <= r["max_ms"] and len(r["times_ms"]) == 2
         assert "visibility" in r["phases"] and r["counters"]["visibility.spans"] > 0
+
+
+def test_stage_settings_are_keywords(scene):
+    default = umbra.render(scene, shadows="bouknight-kelley")
+    unfiltered = umbra.render(scene, shadows="bouknight-kelley", prefilter=False)
+    assert "shadow.pairs_kept_by_prefilter" in default.counters
+    assert "shadow.pairs_kept_by_prefilter" not in unfiltered.counters
+    assert (default.light[0] == unfiltered.light[0]).all(), "a step of ours changes no pixel"
+    zfail = umbra.render(scene, shadows="crow", counting="zfail")
+    assert (zfail.light[0] == default.light[0]).mean() > 0.99
+    rows = umbra.bench(scene, shadows=["crow"], runs=1, warmup=0, counting="zfail")
+    assert rows[0]["shadows"] == "crow"
+    with pytest.raises(umbra.UmbraError) as e:
+        umbra.render(scene, prefilterr=False)
+    assert "prefilterr" in str(e.value) and "prefilter" in str(e.value)
+    with pytest.raises(umbra.UmbraError) as e:
+        umbra.render(scene, shadows="crow", counting="sideways")
+    assert "sideways" in str(e.value)

@@ -177,14 +177,21 @@ impl Explorer {
                     paper = match value.as_str() {
                         "1" | "true" => true,
                         "0" | "false" => false,
-                        _ => return Err(Error::InvalidOption(format!("paper '{value}' is not 1 or 0"))),
+                        _ => return Err(Error::out_of_range("paper", &value, "1 or 0")),
                     }
                 }
                 "width" => r.width = side("width", &value)?,
                 "height" => r.height = side("height", &value)?,
                 "light" => r.light = Some(point(&value)?),
                 "line" | "index" | "x" => {}
-                _ => return Err(Error::InvalidOption(format!("unknown parameter '{key}'"))),
+                _ => {
+                    let known = ["shadows", "paper", "width", "height", "light", "line", "index", "x"];
+                    return Err(Error::UnknownName {
+                        kind: "parameter".into(),
+                        name: key,
+                        known: known.map(String::from).to_vec(),
+                    });
+                }
             }
         }
         if paper {
@@ -308,8 +315,7 @@ impl Explorer {
             .find(|(k, _)| k == "line")
             .ok_or_else(|| Error::InvalidOption("missing parameter 'line'".into()))?
             .1;
-        let line: u32 =
-            line.parse().map_err(|_| Error::InvalidOption(format!("line '{line}' is not a line number")))?;
+        let line: u32 = line.parse().map_err(|_| Error::out_of_range("line", &line, "a line number"))?;
         let scene = self.scene_for(&r)?;
         trace(&scene, line, &r.shadows)
     }
@@ -422,7 +428,7 @@ fn decode(s: &str) -> String {
 fn side(name: &str, value: &str) -> Result<u32> {
     match value.parse::<u32>() {
         Ok(v) if (1..=MAX_SIDE).contains(&v) => Ok(v),
-        _ => Err(Error::InvalidOption(format!("{name} '{value}' is not a whole number from 1 to {MAX_SIDE}"))),
+        _ => Err(Error::out_of_range(name, value, format!("a whole number from 1 to {MAX_SIDE}"))),
     }
 }
 
@@ -430,7 +436,7 @@ fn point(value: &str) -> Result<DVec3> {
     let v: Vec<f64> = value.split(',').filter_map(|c| c.trim().parse().ok()).filter(|c: &f64| c.is_finite()).collect();
     match v[..] {
         [x, y, z] if value.split(',').count() == 3 => Ok(DVec3::new(x, y, z)),
-        _ => Err(Error::InvalidOption(format!("light '{value}' is not three finite numbers x,y,z"))),
+        _ => Err(Error::out_of_range("light", value, "three finite numbers x,y,z")),
     }
 }
 
