@@ -121,12 +121,7 @@ impl<'a> Reference<'a> {
     /// point and the light); `None` on background, for a light that is not an area light,
     /// or where a clip fails.
     pub fn exact_fraction_at(&self, light: usize, x: f64, y: f64) -> Option<f64> {
-        let (poly, p) = self.visible(x, y)?;
-        let area = crate::shadow::AreaLight::of(self.scene, light)?;
-        let (lo, hi) = area.vertices().iter().fold((p, p), |(lo, hi), &q| (lo.min(q), hi.max(q)));
-        let mut near = Vec::new();
-        self.casters.overlapping(lo, hi, |i| near.push(i as usize));
-        fraction_among(self.scene, &self.view, light, p, poly, near.into_iter())
+        Some(self.seen_at(light, x, y, false)?.fraction)
     }
 
     /// Whether pixel `(px, py)` is a tie (see the module's definition).
@@ -227,13 +222,20 @@ impl Reference<'_> {
     /// fraction, step by step as [`exact_fraction`] finds it (`umbra explore` draws it for a
     /// picked pixel). `None` when nothing is seen there or the light is not an area light.
     pub fn light_view_at(&self, light: usize, x: f64, y: f64) -> Option<LightView> {
+        self.seen_at(light, x, y, true)
+    }
+
+    /// The steps at image point `(x, y)`, with the casters found through the BVH (those
+    /// whose boxes meet the box around the point and the light), in polygon order; the cut
+    /// and the shadows kept when `keep`.
+    fn seen_at(&self, light: usize, x: f64, y: f64, keep: bool) -> Option<LightView> {
         let (poly, p) = self.visible(x, y)?;
         let area = crate::shadow::AreaLight::of(self.scene, light)?;
         let (lo, hi) = area.vertices().iter().fold((p, p), |(lo, hi), &q| (lo.min(q), hi.max(q)));
         let mut near = Vec::new();
         self.casters.overlapping(lo, hi, |i| near.push(i as usize));
         near.sort_unstable();
-        view_among(self.scene, &self.view, light, p, poly, near.into_iter(), true)
+        view_among(self.scene, &self.view, light, p, poly, near.into_iter(), keep)
     }
 }
 
