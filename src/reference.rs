@@ -198,7 +198,7 @@ impl<'a> Reference<'a> {
 /// ```
 pub fn exact_fraction(scene: &Scene, light: usize, p: glam::DVec3, poly: usize) -> Option<f64> {
     let casters = (0..scene.polygons.len()).filter(|&i| scene.casts_shadows(i));
-    fraction_among(scene, &View::new(&scene.camera), light, p, poly, casters)
+    Some(view_among(scene, &View::new(&scene.camera), light, p, poly, casters, false)?.fraction)
 }
 
 /// What a point sees of an area light, in the light's own coordinates: the light is the unit
@@ -239,20 +239,9 @@ impl Reference<'_> {
     }
 }
 
-/// [`exact_fraction`] with the casters among `casters` (a superset of those that can cross
-/// a segment from `p` to the light).
-fn fraction_among(
-    scene: &Scene,
-    view: &View,
-    light: usize,
-    p: glam::DVec3,
-    poly: usize,
-    casters: impl Iterator<Item = usize>,
-) -> Option<f64> {
-    Some(view_among(scene, view, light, p, poly, casters, false)?.fraction)
-}
-
-/// The steps of [`exact_fraction`], keeping the cut and the shadows when `keep`.
+/// The steps of [`exact_fraction`] with the casters among `casters` (a superset of those
+/// that can cross a segment from `p` to the light), keeping the cut and the shadows when
+/// `keep`.
 fn view_among(
     scene: &Scene,
     view: &View,
@@ -284,12 +273,11 @@ fn view_among(
         }
         if proj.project(scene.verts(i), &target) {
             let shadow = area.shadow_ab(&proj);
+            let kept = keep.then(|| shadow.clone());
             if !region.rings.is_empty() {
-                region = clip(&region, &Region::from_ring(shadow.clone())).ok()?.outside;
+                region = clip(&region, &Region::from_ring(shadow)).ok()?.outside;
             }
-            if keep {
-                out.hidden.push((i, shadow));
-            }
+            out.hidden.extend(kept.map(|s| (i, s)));
         }
     }
     out.fraction = region.area().abs().min(1.0);

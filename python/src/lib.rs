@@ -125,74 +125,57 @@ fn stage_settings(settings: Option<&Bound<'_, PyDict>>) -> PyResult<um::shadow::
     let Some(settings) = settings else { return Ok(s) };
     for (key, value) in settings.iter() {
         let key: String = key.extract()?;
-        let flag = || value.extract::<bool>();
-        let (bk, awg, nn) = (&mut s.bouknight_kelley, &mut s.atherton_weiler_greenberg, &mut s.nishita_nakamae);
-        match key.as_str() {
-            "prefilter" => bk.prefilter = flag()?,
-            "sphere_grid" => bk.sphere_grid = flag()?,
-            "seen_receivers" => bk.seen_receivers = flag()?,
-            "drop_behind" => bk.drop_behind = flag()?,
-            "wedge" => bk.wedge = flag()?,
-            "solid_cull" => (bk.solid_cull, awg.solid_cull, nn.solid_cull) = (flag()?, flag()?, flag()?),
-            "convex_split" => awg.convex_split = flag()?,
-            "backgrounds" => awg.backgrounds = flag()?,
-            "lone_sheets" => awg.lone_sheets = flag()?,
-            "tiling" => awg.tiling = flag()?,
-            "face_binning" => awg.face_binning = flag()?,
-            "sort_grid" => awg.sort_grid = flag()?,
-            "counting" => s.volumes.counting = value.extract::<String>()?.parse().map_err(error)?,
-            "construction" => s.volumes.construction = value.extract::<String>()?.parse().map_err(error)?,
-            "sight_cuts" => s.volumes.sight_cuts = flag()?,
-            "map_size" => s.williams.map_size = value.extract()?,
-            "bias" => s.williams.bias = value.extract()?,
-            "slope_bias" => s.williams.slope_bias = value.extract()?,
-            "normal_offset" => s.williams.normal_offset = value.extract()?,
-            "receiver_plane" => s.williams.receiver_plane = flag()?,
-            "cull_front" => s.williams.cull_front = flag()?,
-            "fit_to_view" => s.williams.fit_to_view = flag()?,
-            "hull_cull" => nn.hull_cull = flag()?,
-            "convex_bodies" => nn.convex_bodies = flag()?,
-            "same_solid" => nn.same_solid = flag()?,
-            "premise_fallback" => nn.premise_fallback = flag()?,
-            _ => {
-                return Err(UmbraError::new_err(format!(
-                    "unknown stage setting '{key}' (known: {})",
-                    SETTINGS.join(", ")
-                )))
-            }
-        }
+        let Some((_, set)) = SETTINGS.iter().find(|(name, _)| *name == key) else {
+            let known: Vec<&str> = SETTINGS.iter().map(|(name, _)| *name).collect();
+            return Err(UmbraError::new_err(format!("unknown stage setting '{key}' (known: {})", known.join(", "))));
+        };
+        set(&mut s, &value)?;
     }
     Ok(s)
 }
 
-/// The keyword arguments [`stage_settings`] knows.
-const SETTINGS: [&str; 26] = [
-    "prefilter",
-    "sphere_grid",
-    "seen_receivers",
-    "drop_behind",
-    "wedge",
-    "solid_cull",
-    "convex_split",
-    "backgrounds",
-    "lone_sheets",
-    "tiling",
-    "face_binning",
-    "sort_grid",
-    "counting",
-    "construction",
-    "sight_cuts",
-    "map_size",
-    "bias",
-    "slope_bias",
-    "normal_offset",
-    "receiver_plane",
-    "cull_front",
-    "fit_to_view",
-    "hull_cull",
-    "convex_bodies",
-    "same_solid",
-    "premise_fallback",
+/// Sets one setting from a Python value.
+type Setter = fn(&mut um::shadow::StageSettings, &Bound<'_, PyAny>) -> PyResult<()>;
+
+/// A setting parsed by its engine name (`counting = "zfail"`).
+fn named<T: std::str::FromStr<Err = um::Error>>(v: &Bound<'_, PyAny>) -> PyResult<T> {
+    v.extract::<String>()?.parse().map_err(error)
+}
+
+/// Every keyword setting [`stage_settings`] knows, by name.
+const SETTINGS: [(&str, Setter); 26] = [
+    ("prefilter", |s, v| v.extract().map(|x| s.bouknight_kelley.prefilter = x)),
+    ("sphere_grid", |s, v| v.extract().map(|x| s.bouknight_kelley.sphere_grid = x)),
+    ("seen_receivers", |s, v| v.extract().map(|x| s.bouknight_kelley.seen_receivers = x)),
+    ("drop_behind", |s, v| v.extract().map(|x| s.bouknight_kelley.drop_behind = x)),
+    ("wedge", |s, v| v.extract().map(|x| s.bouknight_kelley.wedge = x)),
+    ("solid_cull", |s, v| {
+        let on = v.extract()?;
+        s.bouknight_kelley.solid_cull = on;
+        s.atherton_weiler_greenberg.solid_cull = on;
+        s.nishita_nakamae.solid_cull = on;
+        Ok(())
+    }),
+    ("convex_split", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.convex_split = x)),
+    ("backgrounds", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.backgrounds = x)),
+    ("lone_sheets", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.lone_sheets = x)),
+    ("tiling", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.tiling = x)),
+    ("face_binning", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.face_binning = x)),
+    ("sort_grid", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.sort_grid = x)),
+    ("counting", |s, v| named(v).map(|x| s.volumes.counting = x)),
+    ("construction", |s, v| named(v).map(|x| s.volumes.construction = x)),
+    ("sight_cuts", |s, v| v.extract().map(|x| s.volumes.sight_cuts = x)),
+    ("map_size", |s, v| v.extract().map(|x| s.williams.map_size = x)),
+    ("bias", |s, v| v.extract().map(|x| s.williams.bias = x)),
+    ("slope_bias", |s, v| v.extract().map(|x| s.williams.slope_bias = x)),
+    ("normal_offset", |s, v| v.extract().map(|x| s.williams.normal_offset = x)),
+    ("receiver_plane", |s, v| v.extract().map(|x| s.williams.receiver_plane = x)),
+    ("cull_front", |s, v| v.extract().map(|x| s.williams.cull_front = x)),
+    ("fit_to_view", |s, v| v.extract().map(|x| s.williams.fit_to_view = x)),
+    ("hull_cull", |s, v| v.extract().map(|x| s.nishita_nakamae.hull_cull = x)),
+    ("convex_bodies", |s, v| v.extract().map(|x| s.nishita_nakamae.convex_bodies = x)),
+    ("same_solid", |s, v| v.extract().map(|x| s.nishita_nakamae.same_solid = x)),
+    ("premise_fallback", |s, v| v.extract().map(|x| s.nishita_nakamae.premise_fallback = x)),
 ];
 
 /// Loads a scene file (`docs/scene-format.md`). Raises `UmbraError` naming the file and
