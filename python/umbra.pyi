@@ -57,7 +57,7 @@ def render(
     lone_sheets, tiling, face_binning, sort_grid, counting ("zpass", "zfail", "naive-zpass"),
     construction ("merged", "per-polygon", "crow-1977"), sight_cuts, map_size, bias,
     slope_bias, normal_offset, receiver_plane, cull_front, fit_to_view, hull_cull,
-    convex_bodies, same_solid, premise_fallback."""
+    convex_bodies, same_solid, premise_fallback, lambert."""
 
 def bench(
     scene: Scene,

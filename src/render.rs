@@ -433,7 +433,11 @@ fn shade_frame(
     frame: &mut Frame,
     progress: &Reporter,
 ) -> Vec<BandWork> {
-    let shader = Shader::new(ctx.scene, ctx.view, &ctx.samples);
+    // A stage that gives an area light's irradiance vectors lights its diffuse term.
+    let probe = shadows.walker();
+    let lambert = (0..ctx.scene.lights.len()).map(|l| probe.irradiance(l)).collect();
+    drop(probe);
+    let shader = Shader::with_irradiance(ctx.scene, ctx.view, &ctx.samples, lambert);
     let w = frame.width;
     let band = crate::scan::band_height(frame.height);
     let chunk = (band * w) as usize;
@@ -479,8 +483,7 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
     let mut shadow = Counters::default();
     let mut walker = shadows.walker();
     // Each sample's lit fraction along the line, sample by sample.
-    let sample_count: usize = ctx.samples.iter().map(Vec::len).sum();
-    let mut lit = vec![0.0f32; sample_count * w as usize];
+    let mut lit = vec![0.0f32; ctx.lit_rows() * w as usize];
     let mut line_shading = LineShading::default();
     let (mut self_shadowed, mut walking, mut shading) = (0u64, Duration::ZERO, Duration::ZERO);
     for (y, runs) in (y0..y1).zip(&ctx.runs.lines[y0 as usize..y1 as usize]) {
@@ -599,14 +602,14 @@ fn shadow_terms(
     keep: std::ops::Range<usize>,
 ) -> Vec<Vec<f32>> {
     let (w, h) = (ctx.view.width as usize, ctx.view.height);
-    let samples: usize = ctx.samples.iter().map(Vec::len).sum();
+    let rows = ctx.lit_rows();
     let band = crate::scan::band_height(h);
     let bands: Vec<Vec<f32>> = (0..h.div_ceil(band))
         .into_par_iter()
         .map(|b| {
             let (y0, y1) = (b * band, ((b + 1) * band).min(h));
             let mut walker = stage.walker();
-            let mut lit = vec![0.0f32; samples * w];
+            let mut lit = vec![0.0f32; rows * w];
             // Sample-major rows of this band: `out[k][(y - y0) * w + x]`, 1 where nothing is seen.
             let per_sample = (y1 - y0) as usize * w;
             let mut out = vec![1.0f32; keep.len() * per_sample];
@@ -646,7 +649,9 @@ fn clear(pixels: std::ops::Range<usize>, id: &mut [u32], light: &mut [&mut [f32]
 /// The shadow stage's walk along line `y`: for every run and light sample, the lit fraction
 /// of each pixel into `lit[k * width + x]` (`k` the sample's flat index), 0 where the
 /// sample is behind the run's seen side (the same-side rule, asked before the stage; it is
-/// applied here and nowhere else). After each run and sample, `after(run, light, sample,
+/// applied here and nowhere else); for a light the stage answers as a whole with its
+/// irradiance vector, the vector's components into the light's rows from
+/// `ctx.vector_row(l)` (`lit` holds `ctx.lit_rows()` rows). After each run and sample, `after(run, light, sample,
 /// asked, walker, lit)` sees what was decided (`asked`: whether the stage was). Returns the
 /// runs the same-side rule settled.
 pub(crate) fn walk_line(
@@ -668,6 +673,13 @@ pub(crate) fn walk_line(
                 // copied to the others'.
                 if s == 0 {
                     walker.lit(l, 0, y, run, &mut lit[row.clone()]);
+                    if walker.irradiance(l) {
+                        let at = ctx.vector_row(l) * width;
+                        let (x, rest) = lit[at..].split_at_mut(width);
+                        let (y, z) = rest.split_at_mut(width);
+                        let span = run.x0 as usize..run.x1 as usize;
+                        walker.light_vector(l, [&mut x[span.clone()], &mut y[span.clone()], &mut z[span]]);
+                    }
                     after(run, l, 0, true, walker, &lit[row]);
                 } else {
                     lit.copy_within(row.start - s * width..row.end - s * width, row.start);

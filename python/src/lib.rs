@@ -143,7 +143,7 @@ fn named<T: std::str::FromStr<Err = um::Error>>(v: &Bound<'_, PyAny>) -> PyResul
 }
 
 /// Every keyword setting [`stage_settings`] knows, by name.
-const SETTINGS: [(&str, Setter); 26] = [
+const SETTINGS: [(&str, Setter); 27] = [
     ("prefilter", |s, v| v.extract().map(|x| s.bouknight_kelley.prefilter = x)),
     ("sphere_grid", |s, v| v.extract().map(|x| s.bouknight_kelley.sphere_grid = x)),
     ("seen_receivers", |s, v| v.extract().map(|x| s.bouknight_kelley.seen_receivers = x)),
@@ -175,6 +175,7 @@ const SETTINGS: [(&str, Setter); 26] = [
     ("hull_cull", |s, v| v.extract().map(|x| s.nishita_nakamae.hull_cull = x)),
     ("convex_bodies", |s, v| v.extract().map(|x| s.nishita_nakamae.convex_bodies = x)),
     ("same_solid", |s, v| v.extract().map(|x| s.nishita_nakamae.same_solid = x)),
+    ("lambert", |s, v| v.extract().map(|x| s.nishita_nakamae.lambert = x)),
     ("premise_fallback", |s, v| v.extract().map(|x| s.nishita_nakamae.premise_fallback = x)),
 ];
 

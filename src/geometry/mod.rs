@@ -1,10 +1,11 @@
 //! Planar polygons in f64: Newell normals, planes, the planarity and degeneracy rules of
 //! `docs/scene-format.md` section 2, clipping by a plane, point-in-polygon by the even-odd rule,
-//! Weiler-Atherton polygon clipping ([`weiler_atherton`]), and its shortcut for two convex
-//! polygons ([`convex_split`]).
+//! Weiler-Atherton polygon clipping ([`weiler_atherton`]), its shortcut for two convex
+//! polygons ([`convex_split`]), and Lambert's contour formula (`lambert`).
 
 pub mod convex_split;
 pub mod even_odd;
+pub(crate) mod lambert;
 pub(crate) mod lone_sheets;
 mod rings;
 pub mod weiler_atherton;

@@ -82,6 +82,13 @@ pub(super) struct LaneLight {
     pub attenuation: [f32; 3],
     /// Axis, `cos(cutoff)` and exponent of a spot light's cone.
     pub spot: Option<([f32; 3], f32, f32)>,
+    /// The diffuse term's weight (1, or 0 where it comes from `vector`).
+    pub diffuse: f32,
+    /// The row of lit values that weights it.
+    pub row: usize,
+    /// An area light's centre whose diffuse term comes from irradiance vectors: the first
+    /// of the three lit rows of their components.
+    pub vector: Option<usize>,
 }
 
 /// Where a sample's light comes from.
@@ -362,12 +369,17 @@ impl Pixels {
     /// Adds every light sample's light to `sum`, in the lanes of `mask` (all when `None`).
     #[inline(always)]
     fn add(&self, constants: &[PhongConstants], m: &LaneMaterial, rows: &Rows, mask: Option<f32x8>, sum: &mut V3) {
-        for (k, constants) in constants.iter().enumerate() {
-            let v = rows.at(k, self.at);
+        for constants in constants {
+            let v = rows.at(constants.row, self.at);
             if v == f32x8::ZERO {
                 continue;
             }
-            let light = phong(constants, m, &self.q, &self.n, &self.view, v);
+            let mut light = phong(constants, m, &self.q, &self.n, &self.view, v);
+            if let Some(row) = constants.vector {
+                let vector = [0, 1, 2].map(|c| rows.at(row + c, self.at));
+                let diffuse = lambert(constants, &self.q, &self.n, &vector);
+                light = [0, 1, 2].map(|c| light[c] + diffuse[c]);
+            }
             for c in 0..3 {
                 sum[c] += mask.map_or(light[c], |mask| mask.select(light[c], f32x8::ZERO));
             }
@@ -403,6 +415,15 @@ fn phong(k: &PhongConstants, m: &LaneMaterial, q: &V3, n: &V3, view: &V3, lit: f
     [0, 1, 2].map(|c| k.specular[c].mul_add(spec, k.diffuse[c] * nl) * weight)
 }
 
+/// An area light's diffuse term from each pixel's irradiance vector: `kd Od I f_att(d)
+/// max(0, N · vector)`, `d` to its centre; the same formula as `Shader::lambert`.
+#[inline(always)]
+fn lambert(k: &PhongConstants, q: &V3, n: &V3, vector: &V3) -> V3 {
+    let (_, att) = incident(k, q);
+    let weight = dot(n, vector).max(f32x8::ZERO) * att;
+    [0, 1, 2].map(|c| k.lambert[c] * weight)
+}
+
 /// A light sample and a material's numbers in lanes; the light's radiance is folded into
 /// the material's `kd Od` and `ks Os`.
 #[derive(Debug)]
@@ -414,6 +435,10 @@ struct PhongConstants {
     diffuse: V3,
     specular: V3,
     shininess: f32,
+    row: usize,
+    vector: Option<usize>,
+    /// `kd Od` times the radiance, for the diffuse term from `vector`.
+    lambert: V3,
 }
 
 impl PhongConstants {
@@ -422,15 +447,18 @@ impl PhongConstants {
             Toward::Point(p) => (Some(splat(p)), splat([0.0; 3])),
             Toward::Direction(d) => (None, splat(d)),
         };
-        let times = |a: [f32; 3]| splat([0, 1, 2].map(|c| a[c] * light.radiance[c]));
+        let times = |a: [f32; 3], w: f32| splat([0, 1, 2].map(|c| a[c] * light.radiance[c] * w));
         PhongConstants {
             point,
             direction,
             attenuation: light.attenuation.map(f32x8::splat),
             spot: light.spot.map(|(axis, cos, exponent)| (splat(axis), f32x8::splat(cos), exponent)),
-            diffuse: times(m.diffuse),
-            specular: times(m.specular),
+            diffuse: times(m.diffuse, light.diffuse),
+            specular: times(m.specular, 1.0),
             shininess: m.shininess,
+            row: light.row,
+            vector: light.vector,
+            lambert: times(m.diffuse, 1.0),
         }
     }
 }

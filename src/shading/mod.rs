@@ -93,6 +93,23 @@ pub fn reflect(m: &Material, n: DVec3, v: DVec3, l: DVec3) -> Vec3 {
     m.kd * m.color * nl as f32 + m.ks * m.specular_color * specular(m, n, v, l, nl) as f32
 }
 
+/// `ks Os spec` alone: [`reflect`] without its diffuse term.
+pub fn specular_term(m: &Material, n: DVec3, v: DVec3, l: DVec3) -> Vec3 {
+    let nl = n.dot(l);
+    if nl <= 0.0 {
+        return Vec3::ZERO;
+    }
+    m.ks * m.specular_color * specular(m, n, v, l, nl) as f32
+}
+
+/// An area light's centre (`None` for other lights).
+fn area_centre(light: &Light) -> Option<DVec3> {
+    match light.kind {
+        LightKind::Area { corner, edge_u, edge_v, .. } => Some(corner + 0.5 * (edge_u + edge_v)),
+        _ => None,
+    }
+}
+
 fn specular(m: &Material, n: DVec3, v: DVec3, l: DVec3, nl: f64) -> f64 {
     if m.ks == 0.0 {
         return 0.0;
@@ -130,13 +147,26 @@ fn specular(m: &Material, n: DVec3, v: DVec3, l: DVec3, nl: f64) -> f64 {
 pub(crate) struct Shader<'a> {
     scene: &'a Scene,
     view: &'a View,
-    samples: &'a [Vec<LightSample>],
-    /// Every light sample as the lane kernels see it, in the order of the lit rows, with
-    /// its position for point samples.
+    /// The terms the shading sums.
+    terms: Vec<Term>,
+    /// Every term as the lane kernels see it, with its position for point samples (checked
+    /// against the polygon's plane, [`LANE_RATIO`]).
     lane_lights: Vec<LaneLight>,
     positions: Vec<Option<PointAt>>,
     /// Each material as the lane kernels see it.
     lane_materials: Vec<LaneMaterial>,
+}
+
+/// One term of the shading's sum: a light sample (its intensity the light's over `share`),
+/// weighted by the lit values in row `row`; with `vector`, the centre of an area light,
+/// whose diffuse term comes from the irradiance vectors in the three rows from `vector`.
+#[derive(Debug, Clone, Copy)]
+struct Term {
+    light: usize,
+    at: LightSample,
+    share: usize,
+    row: usize,
+    vector: Option<usize>,
 }
 
 /// Scratch for shading lines, kept from line to line (one per band of lines).
@@ -207,16 +237,54 @@ const LANE_REACH: f64 = 1e15;
 const LANE_RATIO: f64 = 1000.0;
 
 impl<'a> Shader<'a> {
-    /// A shader for `scene` from `view`, with each light's samples.
+    /// A shader for `scene` from `view`, with each light's samples (the tests': every light
+    /// lit by its samples alone).
+    #[cfg(test)]
     pub fn new(scene: &'a Scene, view: &'a View, samples: &'a [Vec<LightSample>]) -> Self {
-        let (lane_lights, positions) = scene
-            .lights
+        Self::with_irradiance(scene, view, samples, vec![false; scene.lights.len()])
+    }
+
+    /// The same, with each light `l` with `lambert[l]` (an area light whose shadow stage
+    /// gives each pixel its irradiance vector, in the three lit rows from `count + 3 l`,
+    /// `count` the number of samples: `ShadowContext::vector_row`)
+    /// shaded as one term at its centre: its diffuse term `kd Od I f_att(d) max(0, N ·
+    /// vector)` from the vector, its specular term that of a point light of the whole
+    /// intensity at its centre, weighted by the light's lit value (its sample 0's row).
+    pub fn with_irradiance(
+        scene: &'a Scene,
+        view: &'a View,
+        samples: &'a [Vec<LightSample>],
+        lambert: Vec<bool>,
+    ) -> Self {
+        let count: usize = samples.iter().map(Vec::len).sum();
+        let mut terms = Vec::new();
+        let mut row = 0;
+        for (l, (light, samples)) in scene.lights.iter().zip(samples).enumerate() {
+            match area_centre(light).filter(|_| lambert[l]) {
+                Some(centre) => {
+                    let vector = Some(count + 3 * l);
+                    terms.push(Term { light: l, at: LightSample::Point(centre), share: 1, row, vector });
+                }
+                None => terms.extend(samples.iter().enumerate().map(|(s, &at)| Term {
+                    light: l,
+                    at,
+                    share: samples.len(),
+                    row: row + s,
+                    vector: None,
+                })),
+            }
+            row += samples.len();
+        }
+        let (lane_lights, positions) = terms
             .iter()
-            .zip(samples)
-            .flat_map(|(light, samples)| samples.iter().map(|s| lane_light(light, s, samples.len(), view.eye)))
+            .map(|t| {
+                let (lane, at) = lane_light(&scene.lights[t.light], &t.at, t.share, view.eye);
+                let diffuse = if t.vector.is_some() { 0.0 } else { 1.0 };
+                (LaneLight { diffuse, row: t.row, vector: t.vector, ..lane }, at.filter(|_| t.vector.is_none()))
+            })
             .unzip();
         let lane_materials = scene.materials.iter().map(lane_material).collect();
-        Shader { scene, view, samples, lane_lights, positions, lane_materials }
+        Shader { scene, view, terms, lane_lights, positions, lane_materials }
     }
 
     /// The ambient term `Ia ka Od` of polygon `poly`.
@@ -255,12 +323,6 @@ impl<'a> Shader<'a> {
         ls.lanes.finish(out);
     }
 
-    /// Every light sample: its light, sample index, and flat index (its row of lit values).
-    fn samples(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
-        let per_light = self.samples.iter().enumerate().flat_map(|(l, s)| (0..s.len()).map(move |s| (l, s)));
-        per_light.enumerate().map(|(k, (l, s))| (l, s, k))
-    }
-
     /// Readies `rs` for `run`, on the line `rs` was readied for.
     fn begin_run(&self, run: &Run, rs: &mut RunShading) {
         let poly = run.poly as usize;
@@ -270,21 +332,64 @@ impl<'a> Shader<'a> {
         (rs.x0, rs.len) = (run.x0, run.x1 - run.x0);
     }
 
-    /// The light at a world point `p` with unit normal `n` (turned toward the viewer), of
-    /// sample `s` of light `l`, in f64.
-    fn shade(&self, poly: usize, l: usize, s: usize, p: DVec3, n: DVec3) -> Vec3 {
-        let (light, samples) = (&self.scene.lights[l], &self.samples[l]);
-        let (to_light, radiance) = incident(light, &samples[s], samples.len(), p);
-        radiance * reflect(self.scene.material(poly), n, (self.view.eye - p).normalize(), to_light)
+    /// The light of term `t` at a world point `p` with unit normal `n` (turned toward the
+    /// viewer), in f64: its specular term alone for an area light's centre, whose diffuse
+    /// term comes from irradiance vectors ([`Shader::lambert`]).
+    fn shade(&self, poly: usize, t: &Term, p: DVec3, n: DVec3) -> Vec3 {
+        let (to_light, radiance) = incident(&self.scene.lights[t.light], &t.at, t.share, p);
+        let m = self.scene.material(poly);
+        let v = (self.view.eye - p).normalize();
+        if t.vector.is_some() {
+            return radiance * specular_term(m, n, v, to_light);
+        }
+        radiance * reflect(m, n, v, to_light)
+    }
+
+    /// An area light's diffuse term (term `t`, its centre) from its irradiance vector
+    /// `vector` at a point `p` with unit normal `n`: `kd Od I f_att(d) max(0, N · vector)`.
+    fn lambert(&self, poly: usize, t: &Term, p: DVec3, n: DVec3, vector: DVec3) -> Vec3 {
+        let (_, radiance) = incident(&self.scene.lights[t.light], &t.at, t.share, p);
+        let m = self.scene.material(poly);
+        radiance * m.kd * m.color * n.dot(vector).max(0.0) as f32
+    }
+
+    /// Adds the diffuse term of each area light lit from irradiance vectors to the run, at
+    /// the points `point(i)` with normals `normal(i)`, the vectors read from `lit`'s rows.
+    fn add_lambert<'l>(
+        &self,
+        rs: &mut RunShading,
+        lanes: &mut LineLanes,
+        lit: impl Fn(usize) -> &'l [f32],
+        point: impl Fn(&RunShading, usize) -> DVec3,
+        normal: impl Fn(&RunShading, usize) -> DVec3,
+    ) {
+        for t in &self.terms {
+            let Some(row) = t.vector else { continue };
+            let [x, y, z] = [lit(row), lit(row + 1), lit(row + 2)];
+            let mut light = std::mem::take(&mut rs.light);
+            light.clear();
+            light.extend((0..rs.len as usize).map(|i| {
+                let vector = DVec3::new(x[i] as f64, y[i] as f64, z[i] as f64);
+                if vector == DVec3::ZERO {
+                    return Vec3::ZERO;
+                }
+                self.lambert(rs.poly, t, point(rs, i), normal(rs, i), vector)
+            }));
+            lanes.add(rs.x0 as usize, &light);
+            rs.light = light;
+        }
     }
 
     /// Flat: one colour per sample, lit at the polygon's centroid with its plane normal.
-    fn flat_run<'l>(&self, rs: &RunShading, lanes: &mut LineLanes, lit: impl Fn(usize) -> &'l [f32]) {
+    /// An area light's diffuse term from irradiance vectors: at the centroid too, with the
+    /// plane normal, from each pixel's vector.
+    fn flat_run<'l>(&self, rs: &mut RunShading, lanes: &mut LineLanes, lit: impl Fn(usize) -> &'l [f32] + Copy) {
         let centroid = centroid(self.scene.verts(rs.poly));
         let n = self.scene.polygons[rs.poly].plane.n * rs.flip;
-        for (l, s, k) in self.samples() {
-            lanes.add_flat(rs.x0 as usize, self.shade(rs.poly, l, s, centroid, n), lit(k));
+        for t in &self.terms {
+            lanes.add_flat(rs.x0 as usize, self.shade(rs.poly, t, centroid, n), lit(t.row));
         }
+        self.add_lambert(rs, lanes, lit, |_, _| centroid, |_, _| n);
     }
 
     /// Gouraud: colours lit at the vertices, interpolated to the two crossings and along the
@@ -294,7 +399,7 @@ impl<'a> Shader<'a> {
         rs: &mut RunShading,
         lanes: &mut LineLanes,
         f64_only: bool,
-        lit: impl Fn(usize) -> &'l [f32],
+        lit: impl Fn(usize) -> &'l [f32] + Copy,
     ) -> bool {
         self.scan_crossings(rs);
         let geometry = if f64_only { None } else { self.lane_geometry(rs) };
@@ -311,9 +416,10 @@ impl<'a> Shader<'a> {
         }
         let verts = self.scene.verts(rs.poly);
         let vn = self.scene.vertex_normals(rs.poly);
-        for (l, s, k) in self.samples() {
+        for t in &self.terms {
+            let k = t.row;
             rs.vertex_colors.clear();
-            rs.vertex_colors.extend(verts.iter().zip(vn).map(|(&p, &n)| self.shade(rs.poly, l, s, p, n * rs.flip)));
+            rs.vertex_colors.extend(verts.iter().zip(vn).map(|(&p, &n)| self.shade(rs.poly, t, p, n * rs.flip)));
             if geometry.is_some() {
                 let at = |c: ScanCrossing| crossing_value(&rs.vertex_colors, c, |v| v.as_dvec3()).as_vec3();
                 lanes.add_gouraud(rs.x0 as usize, at(rs.crossings[0]), at(rs.crossings[1]), lit(k));
@@ -324,6 +430,11 @@ impl<'a> Shader<'a> {
                 weights[i].iter().map(|&(k, a)| colors[k as usize] * a as f32).sum()
             });
         }
+        // An area light's diffuse term from irradiance vectors has no value at the
+        // vertices: at the centroid, with the plane normal, from each pixel's vector (as
+        // flat).
+        let (centroid, n) = (centroid(verts), self.scene.polygons[rs.poly].plane.n * rs.flip);
+        self.add_lambert(rs, lanes, lit, |_, _| centroid, |_, _| n);
         geometry.is_some()
     }
 
@@ -336,7 +447,7 @@ impl<'a> Shader<'a> {
         rs: &mut RunShading,
         lanes: &mut LineLanes,
         f64_only: bool,
-        lit: impl Fn(usize) -> &'l [f32],
+        lit: impl Fn(usize) -> &'l [f32] + Copy,
     ) -> bool {
         let triangle = self.scene.polygons[rs.poly].len == 3;
         if !triangle {
@@ -356,10 +467,13 @@ impl<'a> Shader<'a> {
             self.scan_crossings(rs);
         }
         self.prepare_f64(rs, true);
-        for (l, s, k) in self.samples() {
+        for t in &self.terms {
             let (points, normals) = (&rs.points, &rs.normals);
-            add_f64(&mut rs.light, lanes, rs.x0 as usize, lit(k), |i| self.shade(rs.poly, l, s, points[i], normals[i]));
+            add_f64(&mut rs.light, lanes, rs.x0 as usize, lit(t.row), |i| {
+                self.shade(rs.poly, t, points[i], normals[i])
+            });
         }
+        self.add_lambert(rs, lanes, lit, |rs, i| rs.points[i], |rs, i| rs.normals[i]);
         false
     }
 
@@ -561,7 +675,18 @@ fn lane_light(light: &Light, sample: &LightSample, samples: usize, eye: DVec3) -
         _ => None,
     };
     let radiance = (light.color * (light.intensity / samples as f32)).to_array();
-    (LaneLight { toward, radiance, attenuation: light.attenuation.map(|a| a as f32), spot }, position)
+    (
+        LaneLight {
+            toward,
+            radiance,
+            attenuation: light.attenuation.map(|a| a as f32),
+            spot,
+            diffuse: 1.0,
+            row: 0,
+            vector: None,
+        },
+        position,
+    )
 }
 
 /// A material as the lanes see it.
@@ -581,13 +706,14 @@ mod tests {
     use super::*;
 
     /// Every line of random scenes (convex and star-shaped polygons, point, spot,
-    /// directional and area lights, every shading mode and specular model), shaded with
-    /// the lanes and on the f64 path alone: every pixel agrees.
+    /// directional and area lights, every shading mode and specular model, area lights'
+    /// diffuse terms from irradiance vectors on every other scene), shaded with the lanes
+    /// and on the f64 path alone: every pixel agrees.
     #[test]
     fn lanes_agree_with_the_f64_path_on_random_scenes() {
         use crate::generate::{random, RandomOptions};
         use crate::visibility::{resolve_frame, VisibilityMethod};
-        let (mut worst, mut in_lanes, mut in_f64, mut triangle_runs) = (0.0f32, 0, 0, 0);
+        let (mut worst, mut in_lanes, mut in_f64, mut triangle_runs, mut lambert_lights) = (0.0f32, 0, 0, 0, 0);
         for seed in 0..40u64 {
             let mut scene = random(seed, RandomOptions { polygons: 8, width: 96, height: 72 }).unwrap();
             let mut materials = scene.materials().to_vec();
@@ -604,14 +730,17 @@ mod tests {
             }
             let view = View::new(&scene.camera);
             let samples: Vec<_> = scene.lights.iter().map(Light::samples).collect();
-            let shader = Shader::new(&scene, &view, &samples);
+            // On every other scene, area lights' diffuse terms from irradiance vectors.
+            let lambert = scene.lights.iter().map(|l| seed % 2 == 0 && area_centre(l).is_some()).collect();
+            lambert_lights += scene.lights.iter().filter(|l| seed % 2 == 0 && area_centre(l).is_some()).count();
+            let shader = Shader::with_irradiance(&scene, &view, &samples, lambert);
             let (runs, _) = resolve_frame(&scene, VisibilityMethod::Scanline);
             triangle_runs += runs.lines.iter().flatten().filter(|r| scene.polygons[r.poly as usize].len == 3).count();
             let width = view.width as usize;
-            let count: usize = samples.iter().map(Vec::len).sum();
+            let rows: usize = samples.iter().map(Vec::len).sum::<usize>() + 3 * samples.len();
             let (mut fast, mut slow) = (LineShading::default(), LineShading { f64_only: true, ..Default::default() });
             for (y, line) in runs.lines.iter().enumerate() {
-                let lit: Vec<f32> = (0..count * width).map(|i| [1.0, 0.0, 0.5, 1.0, 0.25][(i + y) % 5]).collect();
+                let lit: Vec<f32> = (0..rows * width).map(|i| [1.0, 0.0, 0.5, 1.0, -0.25][(i + y) % 5]).collect();
                 let (mut a, mut b) = (vec![Vec3::ZERO; width], vec![Vec3::ZERO; width]);
                 shader.shade_line(&mut fast, y as u32, line, &lit, &mut a);
                 shader.shade_line(&mut slow, y as u32, line, &lit, &mut b);
@@ -626,6 +755,7 @@ mod tests {
         }
         assert!(in_lanes > 1000 && in_f64 > 50, "{in_lanes} runs in lanes, {in_f64} in f64");
         assert!(triangle_runs > 500, "{triangle_runs} runs on triangles");
+        assert!(lambert_lights > 5, "{lambert_lights} area lights lit by irradiance vectors");
         eprintln!("worst difference {worst:e} over {in_lanes} runs in lanes, {triangle_runs} on triangles");
     }
 

@@ -272,6 +272,11 @@ pub struct NishitaNakamaeOptions {
     /// an occluder of every pixel of the receiver. Off, the pair is left out as the premise
     /// assumes it never arises: its shadow is missing (not exact).
     pub premise_fallback: bool,
+    /// Shade an area light's diffuse term from the irradiance of the part of the light each
+    /// pixel sees, by Lambert's contour formula (the papers'). Off, the diffuse term is the
+    /// grid's samples' (`docs/shading.md`), each weighted by the exact fraction, as the
+    /// sampling stages shade it. The lit fraction is the same either way.
+    pub lambert: bool,
 }
 
 impl NishitaNakamaeOptions {
@@ -282,6 +287,7 @@ impl NishitaNakamaeOptions {
         convex_bodies: true,
         same_solid: true,
         premise_fallback: true,
+        lambert: true,
     };
 
     /// The papers as published: every polygon a possible occluder of every receiver, each
@@ -292,6 +298,7 @@ impl NishitaNakamaeOptions {
         convex_bodies: false,
         same_solid: false,
         premise_fallback: false,
+        lambert: true,
     };
 }
 
@@ -369,6 +376,18 @@ impl<'a> ShadowContext<'a> {
         self.samples.iter().enumerate().flat_map(|(l, ss)| ss.iter().enumerate().map(move |(s, &x)| (l, s, x)))
     }
 
+    /// How many rows of lit values a line's walk fills (`render::walk_line`): one per light
+    /// sample, then three per light for the irradiance vector of a stage that gives it
+    /// ([`ShadowWalker::irradiance`]; from [`ShadowContext::vector_row`]).
+    pub fn lit_rows(&self) -> usize {
+        self.samples.iter().map(Vec::len).sum::<usize>() + 3 * self.samples.len()
+    }
+
+    /// The first of light `l`'s three rows of its irradiance vector's components.
+    pub fn vector_row(&self, l: usize) -> usize {
+        self.samples.iter().map(Vec::len).sum::<usize>() + 3 * l
+    }
+
     /// The flat index of sample `s` of light `l`.
     pub fn sample_index(&self, l: usize, s: usize) -> usize {
         self.samples[..l].iter().map(Vec::len).sum::<usize>() + s
@@ -409,6 +428,18 @@ pub(crate) trait ShadowWalker {
     fn whole_light(&self, _light: usize) -> bool {
         false
     }
+
+    /// Whether, for a light it answers for as a whole, the stage also gives each pixel the
+    /// irradiance vector of the part of the light it sees ([`ShadowWalker::light_vector`]),
+    /// from which the shading takes the light's diffuse term (`crate::geometry::lambert`).
+    fn irradiance(&self, _light: usize) -> bool {
+        false
+    }
+
+    /// The irradiance vectors of the pixels of the last [`ShadowWalker::lit`] call (for
+    /// light `light`, where [`ShadowWalker::irradiance`] says so), component by component;
+    /// zero where the pixel sees none of the light.
+    fn light_vector(&self, _light: usize, _out: [&mut [f32]; 3]) {}
 
     /// Adds the walker's counters.
     fn finish(&mut self, _counters: &mut Counters) {}
@@ -768,11 +799,13 @@ impl ShadowMethod {
             }
             ShadowMethod::NishitaNakamae(o) => {
                 // Each step that buys speed off by itself (the premise's fallback is what
-                // keeps the stage exact: it goes with the paper path).
+                // keeps the stage exact: it goes with the paper path), and the grid's
+                // shading in place of Lambert's irradiance.
                 out.push(ShadowMethod::NishitaNakamae(NishitaNakamaeOptions { hull_cull: false, ..*o }));
                 out.push(ShadowMethod::NishitaNakamae(NishitaNakamaeOptions { solid_cull: false, ..*o }));
                 out.push(ShadowMethod::NishitaNakamae(NishitaNakamaeOptions { convex_bodies: false, ..*o }));
                 out.push(ShadowMethod::NishitaNakamae(NishitaNakamaeOptions { same_solid: false, ..*o }));
+                out.push(ShadowMethod::NishitaNakamae(NishitaNakamaeOptions { lambert: false, ..*o }));
             }
             ShadowMethod::AthertonWeilerGreenberg(_)
             | ShadowMethod::None
@@ -873,6 +906,7 @@ impl ShadowMethod {
                 on.push((!o.convex_bodies, "--no-convex-bodies".into()));
                 on.push((!o.same_solid, "--no-same-solid".into()));
                 on.push((!o.premise_fallback, "--no-premise-fallback".into()));
+                on.push((!o.lambert, "--no-lambert".into()));
             }
             ShadowMethod::None | ShadowMethod::RayCast | ShadowMethod::Planar => {}
         }

@@ -21,6 +21,9 @@
 //!    by F's plane (the same-side rule), less the projection from the pixel's point of every
 //!    occluder whose penumbra holds it (Weiler and Atherton's clipper); the lit fraction is
 //!    its area over the light's, `docs/scene-format.md` §3's exact fraction.
+//! 6. **Irradiance.** With the area, the irradiance vector of the visible part, by Lambert's
+//!    contour formula (`crate::geometry::lambert`): the papers' illuminance, from which the
+//!    shading takes the light's diffuse term (ours, `lambert` off: the grid's shading).
 //!
 //! Where step 1's premise fails for a pair (O reaches across F's plane, or no nearer F than
 //! every vertex of the light, or the light itself is cut by F's plane), O is kept as an
@@ -40,7 +43,7 @@ use super::projection::{bounding_rectangle, edge_on, Projector, Target};
 use super::{Decision, NishitaNakamaeOptions, ShadowContext, ShadowStage, ShadowWalker};
 use crate::bvh::Bvh;
 use crate::geometry::convex_split::is_convex;
-use crate::geometry::{clip_polygon, Plane};
+use crate::geometry::{clip_polygon, lambert, Plane};
 use crate::scene::{LightKind, LightSample, Scene};
 use crate::stats::Counters;
 use crate::visibility::Run;
@@ -113,17 +116,19 @@ impl AreaLight {
 
     /// Step 5 at point `p` of a polygon with plane `plane`, seen from the side `seen`: the
     /// part of the light cut away by the plane, and the projection from `p` of each of
-    /// `occluders` onto the light, gathered in `hidden`; the fraction is what they leave of
-    /// the light ([`unhidden`]).
-    fn visible_fraction(
+    /// `occluders` onto the light, gathered in `hidden`; what they leave of the light
+    /// ([`unhidden`]), with its irradiance vector when `lambert`.
+    #[allow(clippy::too_many_arguments)]
+    fn visible(
         &self,
         p: DVec3,
         plane: &Plane,
         seen: f64,
         occluders: impl IntoIterator<Item = u32>,
         (scene, bodies): (&Scene, &[bool]),
+        lambert: bool,
         scratch: &mut Scratch,
-    ) -> f64 {
+    ) -> Seen {
         scratch.hidden.clear();
         scratch.bodies.clear();
         let mut cut = Vec::new();
@@ -151,7 +156,22 @@ impl AreaLight {
             scratch.hidden.push(hull);
         }
         scratch.clips += scratch.hidden.len() as u64;
-        unhidden(&scratch.hidden, &mut scratch.sweep)
+        let contour = lambert.then_some(Contour { p, light: *self });
+        unhidden(&scratch.hidden, &mut scratch.sweep, contour.as_ref())
+    }
+
+    /// The irradiance vector of what `p` sees of the light (`seen`, wound as the light's
+    /// coordinates run), turned toward the light and scaled by `d² / A` (`d` from `p` to the
+    /// light's centre, `A` the light's area): so that for a small light far away it is the
+    /// unit vector toward it times the cosine at the light, and a shader's `N · vector`
+    /// times the light's intensity is what a point light there would give, by that cosine
+    /// (ours: the papers' source has a luminance in physical units).
+    fn normalised(&self, p: DVec3, seen: &Seen) -> [f32; 3] {
+        let n = self.edge_u.cross(self.edge_v);
+        let centre = self.corner + 0.5 * (self.edge_u + self.edge_v);
+        // Wound counter-clockwise as seen from p, a ring's vector points away from it.
+        let toward = -n.dot(p - self.corner).signum();
+        (seen.vector * (toward * (centre - p).length_squared() / n.length())).as_vec3().to_array()
     }
 }
 
@@ -212,20 +232,50 @@ struct Scratch {
 struct Sweep {
     parts: Vec<Vec<DVec2>>,
     xs: Vec<f64>,
-    spans: Vec<(f64, f64)>,
-    crossings: Vec<f64>,
+    spans: Vec<Span>,
+    crossings: Vec<Crossing>,
     clipped: Vec<DVec2>,
     tmp: Vec<DVec2>,
+    /// The covered part cut into trapezoids by the sweep, when asked for.
+    trapezoids: Vec<[DVec2; 4]>,
 }
 
-/// The area of the unit square that none of the polygons `hidden` (each simple, convex or
-/// not, in the light's coordinates) covers (ours: where the papers clip polygon by polygon).
-/// Each is first clipped to the square. One left: the square less it. Two convex: less their
-/// areas, plus their intersection's. More: a sweep across the square ([`covered_area`]).
-fn unhidden(hidden: &[Vec<DVec2>], sweep: &mut Sweep) -> f64 {
+/// What a point sees of the light: its fraction of the light's area, and the irradiance
+/// vector of that part (`crate::geometry::lambert`), wound as the light's coordinates run
+/// (zero where not asked for).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Seen {
+    fraction: f64,
+    vector: DVec3,
+}
+
+/// Lambert's contour formula over parts of the light, in the light's coordinates, seen from
+/// a point.
+struct Contour {
+    p: DVec3,
+    light: AreaLight,
+}
+
+impl Contour {
+    /// The irradiance vector of `ring` (simple, in the light's coordinates), wound as the
+    /// coordinates run (counter-clockwise) whichever way `ring` is.
+    fn of(&self, ring: &[DVec2]) -> DVec3 {
+        let AreaLight { corner, edge_u, edge_v } = self.light;
+        let phi = lambert::irradiance_vector(self.p, ring.iter().map(|q| corner + edge_u * q.x + edge_v * q.y));
+        phi * crate::geometry::weiler_atherton::signed_area(ring).signum()
+    }
+}
+
+/// What none of the polygons `hidden` (each simple, convex or not, in the light's
+/// coordinates) covers of the unit square: its area, and with a `contour`, its irradiance
+/// vector (ours: where the papers clip polygon by polygon). Each is first clipped to the
+/// square. One left: the square less it. Two convex: less both, plus their intersection.
+/// More: a sweep across the square ([`covered_area`]), whose trapezoids the vector sums.
+fn unhidden(hidden: &[Vec<DVec2>], sweep: &mut Sweep, contour: Option<&Contour>) -> Seen {
     let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
     let area = |ring: &[DVec2]| crate::geometry::weiler_atherton::signed_area(ring).abs();
-    let Sweep { parts, clipped, tmp, xs, spans, crossings } = sweep;
+    let none = Seen { fraction: 0.0, vector: DVec3::ZERO };
+    let Sweep { parts, clipped, tmp, xs, spans, crossings, trapezoids } = sweep;
     let mut k = 0;
     for ring in hidden {
         clip_convex(ring, &square, clipped, tmp);
@@ -233,7 +283,7 @@ fn unhidden(hidden: &[Vec<DVec2>], sweep: &mut Sweep) -> f64 {
             continue;
         }
         if area(clipped) >= 1.0 - 1e-12 && is_convex(clipped) {
-            return 0.0;
+            return none;
         }
         if parts.len() == k {
             parts.push(Vec::new());
@@ -242,34 +292,68 @@ fn unhidden(hidden: &[Vec<DVec2>], sweep: &mut Sweep) -> f64 {
         k += 1;
     }
     let parts = &parts[..k];
+    // The area first; the vector (dearer) only where some but not all of the light is seen.
+    trapezoids.clear();
+    let convex_pair = matches!(parts, [a, b] if is_convex(a) && is_convex(b));
     let covered = match parts {
         [] => 0.0,
         [a] => area(a),
-        [a, b] if is_convex(a) && is_convex(b) => {
+        [a, b] if convex_pair => {
             clip_convex(a, b, clipped, tmp);
             area(a) + area(b) - area(clipped)
         }
-        _ => covered_area(parts, xs, spans, crossings),
+        _ => covered_area(parts, (xs, spans, crossings), contour.map(|_| &mut *trapezoids)),
     };
     // Slivers of a part touching the light's edge, and rounding, leave areas of 1e-12 and
     // less: within `SLIVER` of none or all of the light is none or all of it.
-    match 1.0 - covered {
-        f if f <= SLIVER => 0.0,
+    let fraction = match 1.0 - covered {
+        f if f <= SLIVER => return none,
         f if f >= 1.0 - SLIVER => 1.0,
         f => f,
+    };
+    let Some(contour) = contour else { return Seen { fraction, vector: DVec3::ZERO } };
+    let whole = lambert::irradiance_vector(contour.p, contour.light.vertices());
+    if fraction == 1.0 {
+        return Seen { fraction, vector: whole };
     }
+    let hidden_vector = match parts {
+        [a] => contour.of(a),
+        [a, b] if convex_pair => {
+            let both = if clipped.len() < 3 { DVec3::ZERO } else { contour.of(clipped) };
+            contour.of(a) + contour.of(b) - both
+        }
+        _ => trapezoids.iter().map(|t| contour.of(t)).sum(),
+    };
+    Seen { fraction, vector: whole - hidden_vector }
 }
 
 /// A share of the light's area below which a part left or hidden counts as nothing
 /// (far below an 8-bit grey level's 1/255).
 const SLIVER: f64 = 1e-9;
 
-/// The area of the unit square covered by the union of `polygons` (even-odd within each).
+/// Scratch of [`covered_area`]: the slabs' bounds, the covered spans of one slab, and one
+/// polygon's crossings with it.
+type SweepScratch<'s> = (&'s mut Vec<f64>, &'s mut Vec<Span>, &'s mut Vec<Crossing>);
+
+/// Where an edge crosses a slab `x0..x1` of the sweep: its `y` at the slab's middle, and at
+/// either side.
+#[derive(Debug, Clone, Copy, Default)]
+struct Crossing {
+    mid: f64,
+    at0: f64,
+    at1: f64,
+}
+
+/// A covered span of a slab: its lower and upper edge's crossings.
+type Span = (Crossing, Crossing);
+
+/// The area of the unit square covered by the union of `polygons` (even-odd within each),
+/// and, into `trapezoids`, the union cut into trapezoids (counter-clockwise), one per slab
+/// between successive corners and crossings and per covered span of it.
 fn covered_area(
     polygons: &[Vec<DVec2>],
-    xs: &mut Vec<f64>,
-    spans: &mut Vec<(f64, f64)>,
-    crossings: &mut Vec<f64>,
+    (xs, spans, crossings): SweepScratch,
+    mut trapezoids: Option<&mut Vec<[DVec2; 4]>>,
 ) -> f64 {
     // A polygon's own edges meet only at its corners (it is simple): only pairs of edges of
     // two polygons can cross.
@@ -314,26 +398,48 @@ fn covered_area(
             for k in 0..poly.len() {
                 let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
                 if (a.x <= x) != (b.x <= x) {
-                    crossings.push(a.y + (b.y - a.y) * (x - a.x) / (b.x - a.x));
+                    let y = |x: f64| (a.y + (b.y - a.y) * (x - a.x) / (b.x - a.x)).clamp(0.0, 1.0);
+                    crossings.push(Crossing { mid: y(x), at0: y(x0), at1: y(x1) });
                 }
             }
-            crossings.sort_unstable_by(f64::total_cmp);
+            crossings.sort_unstable_by(|a, b| a.mid.total_cmp(&b.mid));
             for pair in crossings.chunks_exact(2) {
-                let (lo, hi) = (pair[0].max(0.0), pair[1].min(1.0));
-                if hi > lo {
-                    spans.push((lo, hi));
+                if pair[1].mid > pair[0].mid {
+                    spans.push((pair[0], pair[1]));
                 }
             }
         }
-        spans.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        let (mut covered, mut reach) = (0.0, f64::NEG_INFINITY);
+        spans.sort_unstable_by(|a, b| a.0.mid.total_cmp(&b.0.mid));
+        // The union of the spans, one merged span at a time.
+        let mut merged: Option<Span> = None;
+        let mut close = |(lo, hi): Span, area: &mut f64| {
+            *area += (hi.mid - lo.mid) * (x1 - x0);
+            if let Some(t) = trapezoids.as_mut() {
+                t.push([
+                    DVec2::new(x0, lo.at0),
+                    DVec2::new(x1, lo.at1),
+                    DVec2::new(x1, hi.at1),
+                    DVec2::new(x0, hi.at0),
+                ]);
+            }
+        };
         for &(lo, hi) in spans.iter() {
-            if hi > reach {
-                covered += hi - lo.max(reach);
-                reach = hi;
+            match merged.as_mut() {
+                Some(m) if lo.mid <= m.1.mid => {
+                    if hi.mid > m.1.mid {
+                        m.1 = hi;
+                    }
+                }
+                _ => {
+                    if let Some(m) = merged.replace((lo, hi)) {
+                        close(m, &mut area);
+                    }
+                }
             }
         }
-        area += covered * (x1 - x0);
+        if let Some(m) = merged {
+            close(m, &mut area);
+        }
     }
     area
 }
@@ -342,6 +448,8 @@ fn covered_area(
 pub(crate) struct NishitaNakamae<'a> {
     ctx: &'a ShadowContext<'a>,
     lights: Vec<LightShadows>,
+    /// Whether the walk gives each pixel's irradiance vector of an area light too.
+    lambert: bool,
 }
 
 /// What a light's walk needs.
@@ -405,7 +513,7 @@ impl<'a> NishitaNakamae<'a> {
             })
             .collect();
         counters.add(crate::stats::Counter::Receivers, receivers.len() as u64 * scene.lights.len() as u64);
-        NishitaNakamae { ctx, lights }
+        NishitaNakamae { ctx, lights, lambert: options.lambert }
     }
 }
 
@@ -800,6 +908,8 @@ impl ShadowStage for NishitaNakamae<'_> {
             penumbra: Vec::new(),
             active: Vec::new(),
             ends: Vec::new(),
+            vectors: Vec::new(),
+            whole: Whole::default(),
             scratch: Scratch::default(),
             line: 0,
             tally: Tally::default(),
@@ -816,10 +926,23 @@ struct Walker<'s> {
     /// The casters whose penumbra intervals hold the current pixel, and where each ends.
     active: Vec<u32>,
     ends: Vec<u32>,
+    /// Each pixel's irradiance vector of the light, from the last `lit` of an area light,
+    /// and the pixels of it that see all of the light, with their points.
+    vectors: Vec<[f32; 3]>,
+    whole: Whole,
     scratch: Scratch,
     line: u32,
     tally: Tally,
     last: String,
+}
+
+/// The pixels of a run that see all of the light (their places in the run and points), and
+/// their irradiance vectors.
+#[derive(Debug, Default)]
+struct Whole {
+    index: Vec<u32>,
+    points: Vec<DVec3>,
+    out: Vec<DVec3>,
 }
 
 /// What the walk did, for the counters.
@@ -828,6 +951,22 @@ struct Tally {
     dark: u64,
     lit: u64,
     penumbra: u64,
+}
+
+impl Walker<'_> {
+    /// The irradiance vectors of the pixels in `whole` (which see all of the light), the
+    /// light's corners wound as its coordinates run, into `vectors`; `whole` emptied.
+    fn whole_light_vectors(&mut self, area: &AreaLight) {
+        let Whole { index, points, out } = &mut self.whole;
+        out.clear();
+        out.resize(points.len(), DVec3::ZERO);
+        lambert::irradiance_vectors(&area.vertices(), points, out);
+        for ((&i, &p), &vector) in index.iter().zip(points.iter()).zip(out.iter()) {
+            self.vectors[i as usize] = area.normalised(p, &Seen { fraction: 1.0, vector });
+        }
+        index.clear();
+        points.clear();
+    }
 }
 
 impl ShadowWalker for Walker<'_> {
@@ -841,6 +980,18 @@ impl ShadowWalker for Walker<'_> {
 
     fn whole_light(&self, light: usize) -> bool {
         matches!(self.stage.lights[light].source, Source::Area(_))
+    }
+
+    fn irradiance(&self, light: usize) -> bool {
+        self.stage.lambert && self.whole_light(light)
+    }
+
+    fn light_vector(&self, _light: usize, out: [&mut [f32]; 3]) {
+        for (c, out) in out.into_iter().enumerate() {
+            for (o, v) in out.iter_mut().zip(&self.vectors) {
+                *o = v[c];
+            }
+        }
     }
 
     fn lit(&mut self, light: usize, _sample: usize, line: u32, run: &Run, lit: &mut [f32]) {
@@ -862,14 +1013,19 @@ impl ShadowWalker for Walker<'_> {
         let plane = scene.polygons[run.poly as usize].plane;
         let seen = plane.distance(view.eye).signum();
         let before = self.tally.penumbra;
+        let lambert = self.stage.lambert;
+        self.vectors.clear();
+        self.vectors.resize(lit.len(), [0.0; 3]);
         // What the receiver's plane leaves of the light, the same at every point of it.
-        let unobstructed = if cut {
+        let cut_away: Vec<Vec<DVec2>> = if cut {
             let mut part = Vec::new();
             area.cut_away(&plane, seen, &mut part);
-            unhidden(&[part], &mut self.scratch.sweep) as f32
+            vec![part]
         } else {
-            1.0
+            Vec::new()
         };
+        let unobstructed = unhidden(&cut_away, &mut self.scratch.sweep, None).fraction as f32;
+        let point = |x: u32| view.point_on(&plane, x as f64 + 0.5, line as f64 + 0.5);
         // The penumbra intervals come ordered by their starts: those over pixel x are kept
         // in `active` as x moves along the run.
         let (mut active, mut next) = (std::mem::take(&mut self.active), 0);
@@ -897,16 +1053,30 @@ impl ShadowWalker for Walker<'_> {
                 // No occluder: all of the light on the seen side of the plane reaches it.
                 self.tally.lit += 1;
                 lit[i] = unobstructed;
+                if lambert && cut {
+                    let p = point(x);
+                    let seen = unhidden(&cut_away, &mut self.scratch.sweep, Some(&Contour { p, light: *area }));
+                    self.vectors[i] = area.normalised(p, &seen);
+                } else if lambert {
+                    // All of the light: found for every such pixel of the run at once.
+                    self.whole.index.push(i as u32);
+                    self.whole.points.push(point(x));
+                }
                 continue;
             }
             self.tally.penumbra += 1;
-            let p = view.point_on(&plane, x as f64 + 0.5, line as f64 + 0.5);
+            let p = point(x);
             let occluders = always.iter().chain(&active).copied();
             let bodies = (scene, &shadows.bodies[..]);
-            lit[i] = area.visible_fraction(p, &plane, seen, occluders, bodies, &mut self.scratch) as f32;
+            let seen = area.visible(p, &plane, seen, occluders, bodies, lambert, &mut self.scratch);
+            lit[i] = seen.fraction as f32;
+            if lambert {
+                self.vectors[i] = area.normalised(p, &seen);
+            }
         }
         self.ends.clear();
         self.active = active;
+        self.whole_light_vectors(area);
         self.last = format!(
             "{} umbra and {} penumbra polygon(s) over the run; {} pixel(s) in the penumbra, the visible part of the light clipped there",
             self.umbra.len(),
@@ -926,5 +1096,93 @@ impl ShadowWalker for Walker<'_> {
         counters.add(crate::stats::Counter::PenumbraPixelsClipped, self.tally.penumbra);
         counters.add(crate::stats::Counter::LightPartsHidden, self.scratch.clips);
         counters.add(crate::stats::Counter::ConvexSolidShadows, self.scratch.body_hulls);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::{random, RandomOptions};
+    use crate::reference::Reference;
+    use crate::view::View;
+    use crate::visibility::{resolve_frame, VisibilityMethod};
+
+    /// Every pixel's irradiance vector from the walk is Lambert's formula over the visible
+    /// part of the light that the reference finds by brute force (its rings, a hole wound
+    /// the other way), normalised alike: on the lights scene and random scenes.
+    #[test]
+    fn the_irradiance_vector_is_lamberts_over_the_reference_visible_part() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/lights.toml");
+        let mut lights = Scene::load(path).unwrap();
+        let mut camera = lights.camera().clone();
+        (camera.width, camera.height) = (96, 72);
+        lights.set_camera(camera).unwrap();
+        let randoms = (0..8).map(|seed| random(seed, RandomOptions { width: 48, height: 36, ..Default::default() }));
+        let (mut penumbra, mut checked) = (0, 0);
+        for scene in std::iter::once(lights).chain(randoms.map(Result::unwrap)) {
+            let view = View::new(&scene.camera);
+            let (runs, _) = resolve_frame(&scene, VisibilityMethod::Scanline);
+            let ctx = ShadowContext::new(&scene, &view, &runs, false);
+            let stage = NishitaNakamae::new(&ctx, NishitaNakamaeOptions::DEFAULT, &mut Counters::default());
+            let reference = Reference::new(&scene);
+            let mut walker = stage.walker();
+            let width = view.width as usize;
+            let mut lit = vec![0.0f32; ctx.lit_rows() * width];
+            for (y, line) in runs.lines.iter().enumerate() {
+                walker.start_line(y as u32);
+                crate::render::walk_line(&ctx, walker.as_mut(), y as u32, line, &mut lit, |_, _, _, _, _, _| {});
+                for run in line {
+                    let plane = scene.polygons[run.poly as usize].plane;
+                    for (l, area) in (0..scene.lights.len()).filter_map(|l| Some((l, AreaLight::of(&scene, l)?))) {
+                        let row = ctx.vector_row(l) * width;
+                        for x in run.x0 as usize..run.x1 as usize {
+                            let got = DVec3::from_array([0, 1, 2].map(|c| lit[row + c * width + x] as f64));
+                            let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+                            let Some(seen) = reference.light_view_at(l, px, py) else { continue };
+                            let p = view.point_on(&plane, px, py);
+                            let contour = Contour { p, light: area };
+                            let AreaLight { corner, edge_u, edge_v } = area;
+                            let raw: DVec3 = seen
+                                .visible
+                                .iter()
+                                .map(|r| {
+                                    lambert::irradiance_vector(
+                                        p,
+                                        r.iter().map(|q| corner + edge_u * q.x + edge_v * q.y),
+                                    )
+                                })
+                                .sum();
+                            let wound: f64 =
+                                seen.visible.iter().map(|r| crate::geometry::weiler_atherton::signed_area(r)).sum();
+                            let vector = raw * wound.signum();
+                            let want = DVec3::from_array(
+                                area.normalised(p, &Seen { fraction: seen.fraction, vector }).map(f64::from),
+                            );
+                            let whole = area.normalised(
+                                p,
+                                &Seen {
+                                    fraction: 1.0,
+                                    vector: contour.of(&[DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y]),
+                                },
+                            );
+                            let scale = DVec3::from_array(whole.map(f64::from)).length();
+                            assert!(
+                                (got - want).length() <= 1e-4 * scale,
+                                "pixel ({x}, {y}), light {l}: walk {got}, reference {want} (fraction {})",
+                                seen.fraction
+                            );
+                            // The vector points toward the light where any of it is seen.
+                            if seen.fraction > 1e-6 {
+                                let centre = corner + 0.5 * (edge_u + edge_v);
+                                assert!(got.dot(centre - p) > 0.0, "pixel ({x}, {y}): {got}");
+                            }
+                            checked += 1;
+                            penumbra += (seen.fraction > 0.0 && seen.fraction < 1.0) as usize;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 5000 && penumbra > 300, "{checked} pixels, {penumbra} in penumbrae");
     }
 }

@@ -164,7 +164,7 @@ fn with_stage<T>(
 /// render's own walk.
 fn decide(ctx: &ShadowContext, walker: &mut dyn ShadowWalker, line: u32, runs: &[Run]) -> Vec<ShadowTrace> {
     let mut decisions = Vec::new();
-    let mut lit = vec![0.0f32; ctx.view.width as usize * ctx.all_samples().count()];
+    let mut lit = vec![0.0f32; ctx.view.width as usize * ctx.lit_rows()];
     crate::render::walk_line(ctx, walker, line, runs, &mut lit, |run, l, s, asked, walker, lit| {
         let decision = if asked {
             walker.decision()

@@ -244,6 +244,11 @@ struct ShadowArgs {
     /// (ours leaves them out: none can come between it and the light).
     #[arg(long)]
     no_same_solid: bool,
+    /// Nishita-Nakamae: shade an area light's diffuse term from the grid's samples, each
+    /// weighted by the exact fraction, as the sampling stages do, instead of from the
+    /// irradiance of the part of the light a pixel sees (Lambert's contour formula).
+    #[arg(long)]
+    no_lambert: bool,
     /// Nishita-Nakamae: leave out a caster for which the papers' premise fails (it reaches
     /// as near the light as its nearest corner, or the light is cut by the receiver's plane),
     /// as the papers assume it never arises, instead of taking it at every pixel (ours; off,
@@ -386,6 +391,7 @@ impl ShadowArgs {
                 convex_bodies: !self.no_convex_bodies,
                 same_solid: !self.no_same_solid,
                 premise_fallback: !self.no_premise_fallback,
+                lambert: !self.no_lambert,
             },
         };
         method.with_settings(&settings)
