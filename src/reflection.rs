@@ -26,6 +26,7 @@ use crate::geometry::{clip_in_place, Plane};
 use crate::pool::Pool;
 use crate::scene::{Camera, LightKind, Polygon, Scene};
 use glam::{DMat3, DMat4, DVec3};
+use rayon::prelude::*;
 
 /// How mirrors are rendered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -194,13 +195,19 @@ pub(crate) fn add_reflections(
     if method == ReflectionMethod::Off {
         return Ok(false);
     }
+    // No mirror material, no mirror: the runs (a million on a large scene) are not read.
+    if scene.materials.iter().all(|m| m.mirror <= 0.0) {
+        return Ok(false);
+    }
     let eye = scene.camera.eye;
     let mut mirrors: Vec<u32> = runs
         .lines
-        .iter()
-        .flatten()
-        .map(|r| r.poly)
-        .filter(|&p| scene.material(p as usize).mirror > 0.0 && scene.polygons[p as usize].plane.distance(eye) > 0.0)
+        .par_iter()
+        .flat_map_iter(|line| {
+            line.iter().map(|r| r.poly).filter(|&p| {
+                scene.material(p as usize).mirror > 0.0 && scene.polygons[p as usize].plane.distance(eye) > 0.0
+            })
+        })
         .collect();
     mirrors.sort_unstable();
     mirrors.dedup();

@@ -227,23 +227,33 @@ impl Projection {
     }
 }
 
-/// The world points at the first and last pixel centre of every visible run: each run is a
-/// segment of a planar polygon, so these bound every point the camera sees.
+/// The world points at the first and last pixel centre of every visible run, into `pts`
+/// (a kept list; two a run, not finite where the run's plane passes through the eye): each
+/// run is a segment of a planar polygon, so these bound every point the camera sees. Each
+/// line fills its own stretch, by all threads.
 fn visible_points(ctx: &ShadowContext, mut pts: Vec<DVec3>) -> Vec<DVec3> {
+    let counts = || ctx.runs.lines.iter().map(|runs| 2 * runs.len());
     pts.clear();
-    for (y, runs) in ctx.runs.lines.iter().enumerate() {
+    pts.par_extend(rayon::iter::repeat_n(DVec3::NAN, counts().sum()));
+    let stretches = crate::pieces::stretches(&mut pts, counts());
+    stretches.into_par_iter().zip(&ctx.runs.lines).enumerate().for_each(|(y, (out, runs))| {
         let yc = y as f64 + 0.5;
-        for r in runs {
+        for (out, r) in out.chunks_exact_mut(2).zip(runs) {
             let plane = &ctx.scene.polygons[r.poly as usize].plane;
-            for x in [r.x0, r.x1.saturating_sub(1).max(r.x0)] {
-                let p = ctx.view.point_on(plane, x as f64 + 0.5, yc);
-                if p.is_finite() {
-                    pts.push(p);
-                }
+            for (o, x) in out.iter_mut().zip([r.x0, r.x1.saturating_sub(1).max(r.x0)]) {
+                *o = ctx.view.point_on(plane, x as f64 + 0.5, yc);
             }
         }
-    }
+    });
     pts
+}
+
+/// The least and greatest of `f` over the finite points of `pts`, by all threads.
+fn extent_of(pts: &[DVec3], f: impl Fn(DVec3) -> f64 + Sync) -> (f64, f64) {
+    pts.par_iter()
+        .filter(|p| p.is_finite())
+        .fold(|| (f64::INFINITY, f64::NEG_INFINITY), |(l, h), &c| (l.min(f(c)), h.max(f(c))))
+        .reduce(|| (f64::INFINITY, f64::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)))
 }
 
 /// The bias of one receiver polygon: `constant` in world units along the light's axis, and
@@ -662,7 +672,7 @@ impl LightMaps {
         // from a point light), so the fitted map loses nothing and spends its texels on what
         // is seen. Depth still spans the whole scene.
         let seen = if o.fit_to_view { visible_points(ctx, ctx.pools.points.take()) } else { Vec::new() };
-        let covered = if seen.is_empty() { &corners } else { &seen };
+        let covered = if seen.par_iter().any(|p| p.is_finite()) { &seen } else { &corners };
         let maps = match sample {
             LightSample::Directional(d) => {
                 counters.add(crate::stats::Counter::MapsOrtho, 1);
@@ -670,15 +680,12 @@ impl LightMaps {
                 LightMaps::Single(Box::new(DepthMap::render(ctx, proj, sample, o)))
             }
             LightSample::Point(s) => {
-                let (clo, chi) = covered.iter().fold((covered[0], covered[0]), |(l, h), &p| (l.min(p), h.max(p)));
+                let [x, y, z] = [DVec3::X, DVec3::Y, DVec3::Z].map(|a| extent_of(covered, |c| c.dot(a)));
+                let (clo, chi) = (DVec3::new(x.0, y.0, z.0), DVec3::new(x.1, y.1, z.1));
                 let axis = ((clo + chi) * 0.5 - s).normalize_or(DVec3::NEG_Y);
                 // The widest angle from the axis: the smallest cosine, one arccosine.
-                let half = covered
-                    .iter()
-                    .map(|c| (*c - s).normalize_or(axis).dot(axis))
-                    .fold(1.0, f64::min)
-                    .clamp(-1.0, 1.0)
-                    .acos();
+                let (least, _) = extent_of(covered, |c| (c - s).normalize_or(axis).dot(axis));
+                let half = least.min(1.0).clamp(-1.0, 1.0).acos();
                 let near = 1e-6 * ctx.extent;
                 if half < 80f64.to_radians() {
                     counters.add(crate::stats::Counter::MapsPerspective, 1);
@@ -764,9 +771,7 @@ fn pinhole(eye: DVec3, axis: DVec3, up: DVec3, fov: f64, size: u32, near: f64) -
 /// depth starts before every corner of the scene.
 fn orthographic(u: DVec3, d: DVec3, covered: &[DVec3], corners: &[DVec3], size: u32) -> Projection {
     let v = d.cross(u);
-    let range = |pts: &[DVec3], a: DVec3| {
-        pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| (l.min(c.dot(a)), h.max(c.dot(a))))
-    };
+    let range = |pts: &[DVec3], a: DVec3| extent_of(pts, |c| c.dot(a));
     let ((u0, u1), (v0, v1), (s0, _)) = (range(covered, u), range(covered, v), range(corners, d));
     let side = (u1 - u0).max(v1 - v0) * 1.01 + 1e-12;
     Projection::Ortho {

@@ -93,13 +93,15 @@ pub struct FrameRuns {
 }
 
 impl FrameRuns {
-    /// `visible[i]`: whether scene polygon `i` is seen at some pixel (of `n` polygons).
+    /// `visible[i]`: whether scene polygon `i` is seen at some pixel (of `n` polygons),
+    /// marked by all threads, line by line.
     pub fn visible(&self, n: usize) -> Vec<bool> {
-        let mut v = vec![false; n];
-        for r in self.lines.iter().flatten() {
-            v[r.poly as usize] = true;
-        }
-        v
+        use rayon::prelude::*;
+        use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
+        let mut seen = Vec::new();
+        seen.par_extend((0..n).into_par_iter().map(|_| AtomicBool::new(false)));
+        self.lines.par_iter().for_each(|line| line.iter().for_each(|r| seen[r.poly as usize].store(true, Relaxed)));
+        seen.into_par_iter().map(AtomicBool::into_inner).collect()
     }
 
     /// Number of runs.
