@@ -239,17 +239,26 @@ fn merge(
 ) -> (Overlay, Tally, FxHashMap<u32, Pairs>) {
     let mut total = Tally::default();
     let mut kept_pairs = FxHashMap::default();
+    if !ctx.keep_outlines {
+        // The usual frame: tallies summed and tables moved by all threads (half a million
+        // receivers on a large scene), each receiver's pairs let go where they are.
+        let tally = |(tally, _, _): &(Tally, ReceiverTable, Pairs)| tally.clone();
+        total = per_receiver.par_iter().map(tally).reduce(Tally::default, |mut a, b| {
+            a.add(&b);
+            a
+        });
+        let tables = per_receiver.into_par_iter().map(|(_, table, _)| table).collect();
+        return (Overlay::from_tables(ctx.view.height, false, tables), total, kept_pairs);
+    }
     let mut tables = Vec::with_capacity(per_receiver.len());
     let mut tag = 0;
     for (tally, table, mut pairs) in per_receiver {
         total.add(&tally);
-        if ctx.keep_outlines {
-            for (i, p) in pairs.shadow_polygons.iter_mut().enumerate() {
-                p.0 = tag + i as u32;
-            }
-            tag += table.len() as u32;
-            kept_pairs.insert(table.receiver(), pairs);
+        for (i, p) in pairs.shadow_polygons.iter_mut().enumerate() {
+            p.0 = tag + i as u32;
         }
+        tag += table.len() as u32;
+        kept_pairs.insert(table.receiver(), pairs);
         tables.push(table);
     }
     let overlay = Overlay::from_tables(ctx.view.height, ctx.keep_outlines, tables);
@@ -257,7 +266,7 @@ fn merge(
 }
 
 /// What happened to one receiver's pairs.
-#[derive(Default)]
+#[derive(Default, Clone)]
 struct Tally {
     tested: u64,
     kept: u64,
@@ -428,25 +437,30 @@ impl SphereGrid {
         };
         let g = ((casters.len() as f64).sqrt().ceil() as usize).clamp(4, 1024);
         let mut grid = SphereGrid { extents, domain, g, first: Vec::new(), binned: Vec::new() };
-        // Every (cell, caster) pair, found in parallel and in caster order, then counted
-        // into the cells (a stable counting sort: each cell lists its casters in order).
-        let binned: Vec<(u32, u32)> = casters
-            .par_iter()
-            .flat_map_iter(|&i| grid.cells_of(i).map(move |(c, r)| ((c * g + r) as u32, i)))
-            .collect();
+        // Every (cell, caster) pair as one key, cell first: each caster counts its cells and
+        // fills its own stretch, and the keys are sorted, all by all threads (a million
+        // casters' pairs collected and counted into the cells on one thread were most of
+        // the grid's time). Each cell lists its casters in increasing order.
+        let counts: Vec<usize> = casters.par_iter().map(|&i| grid.cells_of(i).count()).collect();
+        let mut keys = vec![0u64; counts.iter().sum()];
+        crate::pieces::stretches(&mut keys, counts.iter().copied()).into_par_iter().zip(casters).for_each(
+            |(keys, &i)| {
+                for (key, (c, r)) in keys.iter_mut().zip(grid.cells_of(i)) {
+                    *key = ((c * g + r) as u64) << 32 | i as u64;
+                }
+            },
+        );
+        keys.par_sort_unstable();
         let mut first = vec![0u32; g * g + 1];
-        for &(k, _) in &binned {
-            first[k as usize + 1] += 1;
+        let mut cell = 0;
+        for (j, &key) in keys.iter().enumerate() {
+            while cell <= (key >> 32) as usize {
+                first[cell] = j as u32;
+                cell += 1;
+            }
         }
-        for k in 0..g * g {
-            first[k + 1] += first[k];
-        }
-        let mut next = first.clone();
-        grid.binned = vec![0; binned.len()];
-        for (k, i) in binned {
-            grid.binned[next[k as usize] as usize] = i;
-            next[k as usize] += 1;
-        }
+        first[cell..].fill(keys.len() as u32);
+        grid.binned = keys.par_iter().map(|&key| key as u32).collect();
         grid.first = first;
         grid
     }

@@ -176,15 +176,27 @@ impl Overlay {
     /// here.
     pub fn from_tables(height: u32, keep_rings: bool, tables: Vec<ReceiverTable>) -> Self {
         let mut overlay = Overlay::new(height, keep_rings);
-        for mut t in tables.into_iter().filter(|t| t.count > 0) {
-            t.finish();
-            overlay.set_slot(t.receiver, Slot::Table(overlay.tables.len() as u32));
+        // The tables (half a million on a large scene) are finished and moved by all
+        // threads; one thread only numbers them.
+        let mut tables: Vec<ReceiverTable> = tables
+            .into_par_iter()
+            .filter(|t| t.count > 0)
+            .map(|mut t| {
+                t.finish();
+                t
+            })
+            .collect();
+        if let Some(last) = tables.iter().map(|t| t.receiver).max() {
+            overlay.slot.resize(last as usize + 1, None);
+        }
+        for (k, t) in tables.iter_mut().enumerate() {
+            overlay.slot[t.receiver as usize] = Some(Slot::Table(k as u32));
             overlay.base.push(overlay.count as u32);
             overlay.tags.push(t.count);
             overlay.count += t.count as usize;
-            overlay.tables.push(t.table);
-            overlay.rings.extend(t.rings);
+            overlay.rings.append(&mut t.rings);
         }
+        overlay.tables = tables.into_par_iter().map(|t| t.table).collect();
         overlay
     }
 
