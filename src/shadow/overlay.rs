@@ -150,11 +150,11 @@ impl Overlay {
     /// An overlay of polygons given receiver by receiver (each receiver once), tagged in the
     /// order given; `rings_of` gives a polygon's rings (holes by the even-odd rule). The
     /// receivers' edge tables are built in parallel.
-    pub fn from_receivers<P: Sync>(
+    pub fn from_receivers<'r, P: Sync>(
         height: u32,
         keep_rings: bool,
-        receivers: &[(u32, Vec<P>)],
-        rings_of: impl Fn(&P) -> &[Vec<DVec2>] + Sync,
+        receivers: &'r [(u32, Vec<P>)],
+        rings_of: impl Fn(&'r P) -> &'r [Vec<DVec2>] + Sync,
     ) -> Self {
         let tables = receivers
             .par_iter()
