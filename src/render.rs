@@ -435,7 +435,7 @@ fn shade_frame(
 ) -> Vec<BandWork> {
     // A stage that gives an area light's irradiance vectors lights its diffuse term.
     let probe = shadows.walker();
-    let lambert = (0..ctx.scene.lights.len()).map(|l| probe.irradiance(l)).collect();
+    let lambert = (0..ctx.scene.lights.len()).map(|l| probe.irradiance(l).then(|| ctx.vector_row(l))).collect();
     drop(probe);
     let shader = Shader::with_irradiance(ctx.scene, ctx.view, &ctx.samples, lambert);
     let w = frame.width;

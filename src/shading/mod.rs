@@ -241,28 +241,27 @@ impl<'a> Shader<'a> {
     /// lit by its samples alone).
     #[cfg(test)]
     pub fn new(scene: &'a Scene, view: &'a View, samples: &'a [Vec<LightSample>]) -> Self {
-        Self::with_irradiance(scene, view, samples, vec![false; scene.lights.len()])
+        Self::with_irradiance(scene, view, samples, vec![None; scene.lights.len()])
     }
 
-    /// The same, with each light `l` with `lambert[l]` (an area light whose shadow stage
-    /// gives each pixel its irradiance vector, in the three lit rows from `count + 3 l`,
-    /// `count` the number of samples: `ShadowContext::vector_row`)
-    /// shaded as one term at its centre: its diffuse term `kd Od I f_att(d) max(0, N ·
-    /// vector)` from the vector, its specular term that of a point light of the whole
-    /// intensity at its centre, weighted by the light's lit value (its sample 0's row).
+    /// The same, with each light `l` whose `vector_rows[l]` is given (an area light whose
+    /// shadow stage gives each pixel its irradiance vector, in the three lit rows from it:
+    /// `ShadowContext::vector_row`) shaded as one term at its centre: its diffuse term
+    /// `kd Od I f_att(d) max(0, N · vector)` from the vector, its specular term that of a
+    /// point light of the whole intensity at its centre, weighted by the light's lit value
+    /// (its sample 0's row).
     pub fn with_irradiance(
         scene: &'a Scene,
         view: &'a View,
         samples: &'a [Vec<LightSample>],
-        lambert: Vec<bool>,
+        vector_rows: Vec<Option<usize>>,
     ) -> Self {
-        let count: usize = samples.iter().map(Vec::len).sum();
         let mut terms = Vec::new();
         let mut row = 0;
         for (l, (light, samples)) in scene.lights.iter().zip(samples).enumerate() {
-            match area_centre(light).filter(|_| lambert[l]) {
-                Some(centre) => {
-                    let vector = Some(count + 3 * l);
+            match area_centre(light).zip(vector_rows[l]) {
+                Some((centre, vector_row)) => {
+                    let vector = Some(vector_row);
                     terms.push(Term { light: l, at: LightSample::Point(centre), share: 1, row, vector });
                 }
                 None => terms.extend(samples.iter().enumerate().map(|(s, &at)| Term {
@@ -731,9 +730,18 @@ mod tests {
             let view = View::new(&scene.camera);
             let samples: Vec<_> = scene.lights.iter().map(Light::samples).collect();
             // On every other scene, area lights' diffuse terms from irradiance vectors.
-            let lambert = scene.lights.iter().map(|l| seed % 2 == 0 && area_centre(l).is_some()).collect();
-            lambert_lights += scene.lights.iter().filter(|l| seed % 2 == 0 && area_centre(l).is_some()).count();
-            let shader = Shader::with_irradiance(&scene, &view, &samples, lambert);
+            let count: usize = samples.iter().map(Vec::len).sum();
+            let lambert =
+                |(l, light): (usize, &Light)| (seed % 2 == 0 && area_centre(light).is_some()).then_some(count + 3 * l);
+            let rows: Vec<Option<usize>> = scene.lights.iter().enumerate().map(lambert).collect();
+            lambert_lights += rows.iter().flatten().count();
+            let shader = Shader::with_irradiance(&scene, &view, &samples, rows.clone());
+            // A light lit by its vectors reads them from its rows, and its lit value from
+            // its own sample 0's row.
+            for t in shader.terms.iter().filter(|t| t.vector.is_some()) {
+                assert_eq!(t.vector, rows[t.light]);
+                assert_eq!(t.row, samples[..t.light].iter().map(Vec::len).sum::<usize>());
+            }
             let (runs, _) = resolve_frame(&scene, VisibilityMethod::Scanline);
             triangle_runs += runs.lines.iter().flatten().filter(|r| scene.polygons[r.poly as usize].len == 3).count();
             let width = view.width as usize;

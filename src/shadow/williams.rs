@@ -680,8 +680,11 @@ impl LightMaps {
                 LightMaps::Single(Box::new(DepthMap::render(ctx, proj, sample, o)))
             }
             LightSample::Point(s) => {
-                let [x, y, z] = [DVec3::X, DVec3::Y, DVec3::Z].map(|a| extent_of(covered, |c| c.dot(a)));
-                let (clo, chi) = (DVec3::new(x.0, y.0, z.0), DVec3::new(x.1, y.1, z.1));
+                let (clo, chi) = covered
+                    .par_iter()
+                    .filter(|p| p.is_finite())
+                    .fold(|| (DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), &p| (l.min(p), h.max(p)))
+                    .reduce(|| (DVec3::INFINITY, DVec3::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
                 let axis = ((clo + chi) * 0.5 - s).normalize_or(DVec3::NEG_Y);
                 // The widest angle from the axis: the smallest cosine, one arccosine.
                 let (least, _) = extent_of(covered, |c| (c - s).normalize_or(axis).dot(axis));
