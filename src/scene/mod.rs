@@ -651,6 +651,17 @@ impl Scene {
     }
 
     fn compile(&mut self) -> Result<()> {
+        // Reserved as planar faces need (a fan piece's corners may grow them): a million
+        // triangles' lists are most of a scene's memory, and doubling them as they fill left
+        // a third of it unused.
+        let faces = self.objects.iter().flat_map(|o| &o.mesh.faces);
+        let corners: usize = faces.clone().map(|f| f.vertices.len()).sum();
+        self.polygons.reserve_exact(faces.count());
+        self.solid_of.reserve_exact(self.polygons.capacity());
+        for list in [&mut self.vertices, &mut self.normals] {
+            list.reserve_exact(corners);
+        }
+        self.across.reserve_exact(corners);
         for (oi, obj) in self.objects.iter().enumerate() {
             let m = obj.transform.matrix();
             let nm = DMat3::from_mat4(m).inverse().transpose();
@@ -728,6 +739,11 @@ impl Scene {
             self.across
                 .extend(found.across.into_iter().map(|q| if q == solids::NO_SOLID { NO_POLYGON } else { p0 + q }));
         }
+        self.polygons.shrink_to_fit();
+        self.solid_of.shrink_to_fit();
+        self.vertices.shrink_to_fit();
+        self.normals.shrink_to_fit();
+        self.across.shrink_to_fit();
         self.bounds = self.vertex_bounds();
         Ok(())
     }
