@@ -180,6 +180,11 @@ const RINGS_PER_PIECE: usize = 4096;
 /// A table with at least this many edges is sorted by all threads.
 const PARALLEL_SORT: usize = 1 << 16;
 
+/// A table with at most this many edges is sorted where it lies, by the standard library's
+/// stable sort (whose scratch for so few 40-byte edges is on the stack), not scattered into a
+/// second buffer.
+const SORT_IN_PLACE: usize = 96;
+
 /// Places the `edges` that start on the table's lines `lines` (counted from `lo`, the
 /// table's first line) into `out`, which holds exactly those lines' buckets, in order.
 fn scatter(edges: &[Edge], lo: u32, bucket: &[u32], lines: Range<usize>, out: &mut [Edge]) {
@@ -308,6 +313,13 @@ impl EdgeTable {
         for i in 0..n {
             self.bucket[i + 1] += self.bucket[i];
         }
+        if self.edges.len() <= SORT_IN_PLACE {
+            // A stable sort by first line orders them as the buckets do, with no second
+            // buffer (half a million receivers' small tables each kept one).
+            self.edges.sort_by_key(|e| e.first);
+            self.mark_long(false);
+            return;
+        }
         let mut sorted = std::mem::take(&mut self.spare);
         sorted.clear();
         // A fresh list of millions of edges is first touched here: in parallel, its pages
@@ -320,6 +332,11 @@ impl EdgeTable {
             scatter(&self.edges, lo, &self.bucket, 0..n, &mut sorted);
         }
         self.spare = std::mem::replace(&mut self.edges, sorted);
+        self.mark_long(parallel);
+    }
+
+    /// Lists the sorted edges longer than [`LONG_EDGE`] lines.
+    fn mark_long(&mut self, parallel: bool) {
         self.long.clear();
         let is_long = |(i, e): (usize, &Edge)| (e.end - e.first > LONG_EDGE).then_some(i as u32);
         if parallel {

@@ -115,7 +115,7 @@ fn shadow_polygons(
     let t = Instant::now();
     let extents = options.prefilter.then(|| Extents::new(scene, sample, &casters, &receivers));
     let (grid, extents) = match extents {
-        Some(e) if options.sphere_grid => (Some(SphereGrid::new(e, sample, &casters)), None),
+        Some(e) if options.sphere_grid => (Some(SphereGrid::new(e, scene, &casters)), None),
         e => (None, e),
     };
     counters.add(crate::stats::Counter::PrefilterGridUs, t.elapsed().as_micros() as u64);
@@ -124,9 +124,8 @@ fn shadow_polygons(
     // `RECEIVERS_PER_PIECE` (rayon's own cut leaves a few long pieces, and a thread that
     // runs out of work waits for the last); the pieces share their threads' stamps.
     let stamps = Pool::default();
-    let per_receiver: Vec<(Tally, ReceiverTable, Pairs)> = receivers
-        .par_iter()
-        .with_max_len(RECEIVERS_PER_PIECE)
+    let pieces: Vec<Piece> = receivers
+        .par_chunks(RECEIVERS_PER_PIECE)
         .map_init(
             || {
                 let mut stamp = stamps.lease();
@@ -136,26 +135,33 @@ fn shadow_polygons(
                 }
                 (Projector::default(), stamp, [Vec::new(), Vec::new()], Vec::new(), Vec::new())
             },
-            |(proj, stamp, scratch, ring, candidates), &b| {
-                let t = Instant::now();
-                let mut tested = 0;
-                match (&grid, &extents) {
-                    (Some(g), _) => g.candidates(b, stamp, candidates),
-                    (None, Some(e)) => tested = e.every_pair(b, &casters, candidates),
-                    (None, None) => candidates.clone_from(&casters),
+            |(proj, stamp, scratch, ring, candidates), receivers| {
+                let mut piece = Piece::default();
+                for &b in receivers {
+                    let t = Instant::now();
+                    let mut tested = 0;
+                    match (&grid, &extents) {
+                        (Some(g), _) => g.candidates(b, scene.verts(b as usize), stamp, candidates),
+                        (None, Some(e)) => tested = e.every_pair(b, &casters, candidates),
+                        (None, None) => candidates.clone_from(&casters),
+                    }
+                    let prefilter_ns = t.elapsed().as_nanos() as u64;
+                    let t = Instant::now();
+                    let (mut tally, table, pairs) =
+                        project_onto(ctx, options, sample, b, candidates, proj, scratch, ring);
+                    tally.tested += tested;
+                    tally.prefilter_ns += prefilter_ns;
+                    tally.projection_ns += t.elapsed().as_nanos() as u64;
+                    piece.add(tally, table, pairs, ctx.keep_outlines);
                 }
-                let prefilter_ns = t.elapsed().as_nanos() as u64;
-                let t = Instant::now();
-                let (mut tally, table, pairs) = project_onto(ctx, options, sample, b, candidates, proj, scratch, ring);
-                tally.tested += tested;
-                tally.prefilter_ns += prefilter_ns;
-                tally.projection_ns += t.elapsed().as_nanos() as u64;
-                (tally, table, pairs)
+                piece
             },
         )
         .collect();
+    // The grid is let go before the overlay is made (a million polygons' cones).
+    drop((grid, extents));
 
-    let (overlay, total, kept_pairs) = merge(ctx, per_receiver);
+    let (overlay, total, kept_pairs) = merge(ctx, pieces);
     if options.prefilter {
         counters.add(crate::stats::Counter::PairsKeptByPrefilter, total.kept);
         if !options.sphere_grid {
@@ -231,29 +237,45 @@ fn project_onto(
 /// The most receivers one piece of the parallel loop over them takes.
 const RECEIVERS_PER_PIECE: usize = 512;
 
+/// One piece of the loop over receivers: their tallies summed, and their tables. In the
+/// usual frame only the tables that hold shadow polygons are kept (most receivers' are
+/// empty) and the pairs are let go; for traces, every receiver's table and pairs, in order.
+#[derive(Default)]
+struct Piece {
+    tally: Tally,
+    tables: Vec<ReceiverTable>,
+    pairs: Vec<Pairs>,
+}
+
+impl Piece {
+    fn add(&mut self, tally: Tally, table: ReceiverTable, pairs: Pairs, keep_pairs: bool) {
+        self.tally.add(&tally);
+        if keep_pairs {
+            self.pairs.push(pairs);
+        } else if table.len() == 0 {
+            return;
+        }
+        self.tables.push(table);
+    }
+}
+
 /// Every receiver's shadow polygons into one overlay, tagged with their receiver, and the
 /// tallies summed.
-fn merge(
-    ctx: &ShadowContext,
-    per_receiver: Vec<(Tally, ReceiverTable, Pairs)>,
-) -> (Overlay, Tally, FxHashMap<u32, Pairs>) {
+fn merge(ctx: &ShadowContext, pieces: Vec<Piece>) -> (Overlay, Tally, FxHashMap<u32, Pairs>) {
     let mut total = Tally::default();
+    for piece in &pieces {
+        total.add(&piece.tally);
+    }
     let mut kept_pairs = FxHashMap::default();
     if !ctx.keep_outlines {
-        // The usual frame: tallies summed and tables moved by all threads (half a million
-        // receivers on a large scene), each receiver's pairs let go where they are.
-        let tally = |(tally, _, _): &(Tally, ReceiverTable, Pairs)| tally.clone();
-        total = per_receiver.par_iter().map(tally).reduce(Tally::default, |mut a, b| {
-            a.add(&b);
-            a
-        });
-        let tables = per_receiver.into_par_iter().map(|(_, table, _)| table).collect();
+        // The usual frame: the tables (a hundred thousand on a large scene) moved by all
+        // threads.
+        let tables = pieces.into_par_iter().flat_map_iter(|piece| piece.tables);
         return (Overlay::from_tables(ctx.view.height, false, tables), total, kept_pairs);
     }
-    let mut tables = Vec::with_capacity(per_receiver.len());
+    let mut tables = Vec::new();
     let mut tag = 0;
-    for (tally, table, mut pairs) in per_receiver {
-        total.add(&tally);
+    for (table, mut pairs) in pieces.into_iter().flat_map(|piece| piece.tables.into_iter().zip(piece.pairs)) {
         for (i, p) in pairs.shadow_polygons.iter_mut().enumerate() {
             p.0 = tag + i as u32;
         }
@@ -261,7 +283,7 @@ fn merge(
         kept_pairs.insert(table.receiver(), pairs);
         tables.push(table);
     }
-    let overlay = Overlay::from_tables(ctx.view.height, ctx.keep_outlines, tables);
+    let overlay = Overlay::from_tables(ctx.view.height, ctx.keep_outlines, tables.into_par_iter());
     (overlay, total, kept_pairs)
 }
 
@@ -363,12 +385,16 @@ impl Extent {
 }
 
 /// Step 2, the sphere prefilter: every caster's and receiver's extent on the sphere around
-/// the light (on the plane across a directional light).
+/// the light (on the plane across a directional light). What the pair test reads is kept, one
+/// entry per polygon: a point light's cones, a directional light's boxes. A point light's
+/// boxes (in polar angle and azimuth) only place polygons in the [`SphereGrid`], which works
+/// them out again where it needs them (kept, they were 80 bytes a polygon).
 struct Extents {
-    /// Each polygon's extent: its boxes, and its cone.
-    boxes: Vec<Boxes>,
+    /// A directional light: each polygon's box on the plane across the light.
+    boxes: Vec<[f64; 4]>,
+    /// A point light: each polygon's cone.
     cones: Vec<Cone>,
-    point: bool,
+    sample: LightSample,
 }
 
 impl Extents {
@@ -379,12 +405,28 @@ impl Extents {
         for &i in casters.iter().chain(receivers) {
             wanted[i as usize] = true;
         }
-        let (boxes, cones) = (0..n)
-            .into_par_iter()
-            .map(|i| if wanted[i] { extent(scene.verts(i), sample) } else { Extent::NONE })
-            .map(|e| (e.boxes, e.cone))
-            .unzip();
-        Extents { boxes, cones, point: matches!(sample, LightSample::Point(_)) }
+        let of = |i: usize| if wanted[i] { extent(scene.verts(i), sample) } else { Extent::NONE };
+        let mut extents = Extents { boxes: Vec::new(), cones: Vec::new(), sample };
+        match sample {
+            LightSample::Point(_) => extents.cones.par_extend((0..n).into_par_iter().map(|i| of(i).cone)),
+            LightSample::Directional(_) => {
+                let whole = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+                extents.boxes.par_extend((0..n).into_par_iter().map(|i| of(i).boxes[0].unwrap_or(whole)))
+            }
+        }
+        extents
+    }
+
+    fn point(&self) -> bool {
+        matches!(self.sample, LightSample::Point(_))
+    }
+
+    /// Polygon `i`'s boxes (of vertices `verts`).
+    fn boxes_of(&self, i: u32, verts: &[DVec3]) -> Boxes {
+        match self.sample {
+            LightSample::Point(_) => extent(verts, self.sample).boxes,
+            LightSample::Directional(_) => [Some(self.boxes[i as usize]), None],
+        }
     }
 
     /// Whether the extents of polygons `a` and `b` overlap: for a point light, their cones
@@ -393,11 +435,11 @@ impl Extents {
     /// bh)`, with a hair of slack so that rounding can only keep a pair, never drop one);
     /// for a directional light, their boxes.
     fn overlap(&self, a: u32, b: u32) -> bool {
-        if self.point {
+        if self.point() {
             let (ac, bc) = (self.cones[a as usize], self.cones[b as usize]);
             return ac.half + bc.half >= PI || ac.axis.dot(bc.axis) >= ac.cos * bc.cos - ac.sin * bc.sin - 1e-12;
         }
-        let (Some(p), Some(q)) = (self.boxes[a as usize][0], self.boxes[b as usize][0]) else { return true };
+        let (p, q) = (self.boxes[a as usize], self.boxes[b as usize]);
         p[0] <= q[2] && q[0] <= p[2] && p[1] <= q[3] && q[1] <= p[3]
     }
 
@@ -424,13 +466,13 @@ struct SphereGrid {
 }
 
 impl SphereGrid {
-    fn new(extents: Extents, sample: LightSample, casters: &[u32]) -> Self {
-        let domain = match sample {
+    fn new(extents: Extents, scene: &Scene, casters: &[u32]) -> Self {
+        let domain = match extents.sample {
             LightSample::Point(_) => [0.0, -PI, PI, PI],
             LightSample::Directional(_) => extents
                 .boxes
                 .iter()
-                .flat_map(|b| b.iter().flatten())
+                .filter(|b| b[0] <= b[2])
                 .fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |d, b| {
                     [d[0].min(b[0]), d[1].min(b[1]), d[2].max(b[2]), d[3].max(b[3])]
                 }),
@@ -441,15 +483,18 @@ impl SphereGrid {
         // fills its own stretch, and the keys are sorted, all by all threads (a million
         // casters' pairs collected and counted into the cells on one thread were most of
         // the grid's time). Each cell lists its casters in increasing order.
-        let counts: Vec<usize> = casters.par_iter().map(|&i| grid.cells_of(i).count()).collect();
+        let boxes: Vec<Boxes> =
+            casters.par_iter().map(|&i| grid.extents.boxes_of(i, scene.verts(i as usize))).collect();
+        let counts: Vec<usize> = boxes.par_iter().map(|b| grid.cells_of(*b).count()).collect();
         let mut keys = vec![0u64; counts.iter().sum()];
-        crate::pieces::stretches(&mut keys, counts.iter().copied()).into_par_iter().zip(casters).for_each(
-            |(keys, &i)| {
-                for (key, (c, r)) in keys.iter_mut().zip(grid.cells_of(i)) {
+        crate::pieces::stretches(&mut keys, counts.iter().copied()).into_par_iter().zip(casters).zip(&boxes).for_each(
+            |((keys, &i), b)| {
+                for (key, (c, r)) in keys.iter_mut().zip(grid.cells_of(*b)) {
                     *key = ((c * g + r) as u64) << 32 | i as u64;
                 }
             },
         );
+        drop(boxes);
         keys.par_sort_unstable();
         let mut first = vec![0u32; g * g + 1];
         let mut cell = 0;
@@ -471,22 +516,22 @@ impl SphereGrid {
         &self.binned[self.first[k] as usize..self.first[k + 1] as usize]
     }
 
-    /// The grid cells (column, row) that polygon `i`'s extent touches.
-    fn cells_of(&self, i: u32) -> impl Iterator<Item = (usize, usize)> + '_ {
+    /// The grid cells (column, row) that an extent's `boxes` touch.
+    fn cells_of(&self, boxes: Boxes) -> impl Iterator<Item = (usize, usize)> + '_ {
         let d = self.domain;
         let (lo, size) = (DVec2::new(d[0], d[1]), DVec2::new(d[2] - d[0], d[3] - d[1]).max(DVec2::splat(1e-300)));
         let g = self.g;
-        let boxes = self.extents.boxes[i as usize].into_iter().flatten();
+        let boxes = boxes.into_iter().flatten();
         boxes.flat_map(move |b| grid_cells(lo, size, (g, g), (DVec2::new(b[0], b[1]), DVec2::new(b[2], b[3]))))
     }
 
-    /// The casters whose extents overlap receiver `b`'s: those sharing a grid cell with it
-    /// whose bounding cones overlap (for a point light; shared cells suffice for a
-    /// directional light, whose boxes are the cells' own test). `stamp` is scratch, one entry
-    /// per polygon, that keeps each caster from being listed twice.
-    fn candidates(&self, b: u32, stamp: &mut [u32], out: &mut Vec<u32>) {
+    /// The casters whose extents overlap receiver `b`'s (of vertices `verts`): those sharing
+    /// a grid cell with it whose bounding cones overlap (for a point light; shared cells
+    /// suffice for a directional light, whose boxes are the cells' own test). `stamp` is
+    /// scratch, one entry per polygon, that keeps each caster from being listed twice.
+    fn candidates(&self, b: u32, verts: &[DVec3], stamp: &mut [u32], out: &mut Vec<u32>) {
         out.clear();
-        for (c, r) in self.cells_of(b) {
+        for (c, r) in self.cells_of(self.extents.boxes_of(b, verts)) {
             for &a in self.cell(c, r) {
                 if stamp[a as usize] == b {
                     continue;
@@ -494,7 +539,7 @@ impl SphereGrid {
                 stamp[a as usize] = b;
                 // Shared cells are a directional light's box test; a point light's cones
                 // are compared.
-                if !self.extents.point || self.extents.overlap(a, b) {
+                if !self.extents.point() || self.extents.overlap(a, b) {
                     out.push(a);
                 }
             }
@@ -717,11 +762,11 @@ mod tests {
             let n = scene.polygons.len();
             let casters: Vec<u32> = (0..n as u32).collect();
             let sample = LightSample::Point(light);
-            let grid = SphereGrid::new(Extents::new(&scene, sample, &casters, &casters), sample, &casters);
+            let grid = SphereGrid::new(Extents::new(&scene, sample, &casters, &casters), &scene, &casters);
             let mut stamp = vec![u32::MAX; n];
             let (mut found, mut kept) = (0, Vec::new());
             for b in 0..n as u32 {
-                grid.candidates(b, &mut stamp, &mut kept);
+                grid.candidates(b, scene.verts(b as usize), &mut stamp, &mut kept);
                 let t = scene.verts(b as usize);
                 for _ in 0..200 {
                     let (u, v) = (rng.gen_range(0.0..1.0f64), rng.gen_range(0.0..1.0f64));

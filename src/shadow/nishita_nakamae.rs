@@ -544,9 +544,9 @@ fn gather(
             everywhere.insert(b, e);
         }
     }
-    let mut umbra = Overlay::from_tables(height, false, umbras);
+    let mut umbra = Overlay::from_tables(height, false, umbras.into_par_iter());
     umbra.add_wholes(&dark);
-    let penumbra = Overlay::from_tables(height, false, penumbras);
+    let penumbra = Overlay::from_tables(height, false, penumbras.into_par_iter());
     counters.add(crate::stats::Counter::Pairs, pairs);
     counters.add(crate::stats::Counter::UmbraPolygons, umbra.len() as u64);
     counters.add(crate::stats::Counter::PenumbraPolygons, penumbra.len() as u64);

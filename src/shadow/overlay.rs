@@ -166,20 +166,19 @@ impl Overlay {
                 table.finish();
                 table
             })
-            .collect();
-        Overlay::from_tables(height, keep_rings, tables)
+            .collect::<Vec<_>>();
+        Overlay::from_tables(height, keep_rings, tables.into_par_iter())
     }
 
     /// An overlay of receivers' tables (each receiver once), tagged in the order given:
     /// table `k`'s polygon `i` gets tag `i` plus the number of polygons before it. Tables
     /// are best finished where they were built, in parallel; any that is not is finished
     /// here.
-    pub fn from_tables(height: u32, keep_rings: bool, tables: Vec<ReceiverTable>) -> Self {
+    pub fn from_tables(height: u32, keep_rings: bool, tables: impl ParallelIterator<Item = ReceiverTable>) -> Self {
         let mut overlay = Overlay::new(height, keep_rings);
         // The tables (half a million on a large scene) are finished and moved by all
         // threads; one thread only numbers them.
         let mut tables: Vec<ReceiverTable> = tables
-            .into_par_iter()
             .filter(|t| t.count > 0)
             .map(|mut t| {
                 t.finish();
