@@ -102,7 +102,7 @@ pub fn rasterize<D: Depth>(
         .map(|(bi, (depth, ids))| {
             let y0 = bi as u32 * band;
             let rows = BandRows { y0, lines: y0..(y0 + band).min(h), width, height: h, depth, ids };
-            draw_band(members[bi].iter().map(|&i| &screen[i as usize]).map(|p| (p, screen.ring(p))), rows)
+            draw_band(members[bi].iter().map(|&i| screen.get(i)), rows)
         })
         .collect();
     DepthBuffer { ids, depth, tests: counts.iter().map(|c| c.0).sum(), writes: counts.iter().map(|c| c.1).sum() }

@@ -105,7 +105,7 @@ struct Band<'f> {
 fn depth_complexity(screen: &Screen, w: u32, h: u32) -> Vec<u32> {
     let mut count = vec![0u32; (w * h) as usize];
     let mut table = crate::scan::EdgeTable::new(h);
-    for (_, ring) in screen.iter() {
+    for (_, _, ring) in screen.iter() {
         crate::scan::for_each_span(&mut table, &[ring], w, h, 0..h, |y, x0, x1| {
             for c in &mut count[(y * w + x0) as usize..(y * w + x1) as usize] {
                 *c += 1;

@@ -182,7 +182,7 @@ const PARALLEL_SORT: usize = 1 << 16;
 
 /// A table with at most this many edges is sorted where it lies, by the standard library's
 /// stable sort (whose scratch for so few 40-byte edges is on the stack), not scattered into a
-/// second buffer.
+/// second buffer, and keeps no buckets.
 const SORT_IN_PLACE: usize = 96;
 
 /// Places the `edges` that start on the table's lines `lines` (counted from `lo`, the
@@ -284,8 +284,16 @@ impl EdgeTable {
             self.edges.iter().fold((u32::MAX, 0), |(lo, hi), e| (lo.min(e.first), hi.max(e.end)))
         };
         self.lines = lo..hi.max(lo);
-        let n = (self.lines.end - lo) as usize;
         self.bucket.clear();
+        if self.edges.len() <= SORT_IN_PLACE {
+            // A stable sort by first line orders them as the buckets do, with no second
+            // buffer and no bucket per line: a line's first edge is found by bisection
+            // (half a million receivers' small tables each kept both, 80 MB on s3).
+            self.edges.sort_by_key(|e| e.first);
+            self.mark_long(false);
+            return;
+        }
+        let n = (self.lines.end - lo) as usize;
         self.bucket.resize(n + 1, 0);
         let count = |edges: &[Edge], per_line: &mut [u32]| {
             for e in edges {
@@ -312,13 +320,6 @@ impl EdgeTable {
         }
         for i in 0..n {
             self.bucket[i + 1] += self.bucket[i];
-        }
-        if self.edges.len() <= SORT_IN_PLACE {
-            // A stable sort by first line orders them as the buckets do, with no second
-            // buffer (half a million receivers' small tables each kept one).
-            self.edges.sort_by_key(|e| e.first);
-            self.mark_long(false);
-            return;
         }
         let mut sorted = std::mem::take(&mut self.spare);
         sorted.clear();
@@ -380,12 +381,13 @@ impl EdgeTable {
         self.edges.len()
     }
 
-    fn starting_on(&self, line: u32) -> &[Edge] {
-        if !self.lines.contains(&line) {
-            return &[];
+    /// The number of edges that start above `line`, one of the table's lines or its end:
+    /// from the buckets, or by bisection in a small table, which has none.
+    fn before(&self, line: u32) -> usize {
+        match self.bucket.is_empty() {
+            true => self.edges.partition_point(|e| e.first < line),
+            false => self.bucket[(line - self.lines.start) as usize] as usize,
         }
-        let i = (line - self.lines.start) as usize;
-        &self.edges[self.bucket[i] as usize..self.bucket[i + 1] as usize]
     }
 }
 
@@ -400,6 +402,9 @@ pub struct ActiveEdges<'a> {
     end: u32,
     active: Vec<Crossing>,
     incoming: Vec<Crossing>,
+    /// The first edge of the table not entered yet (edges are sorted by first line, and the
+    /// walk takes one line after another).
+    cursor: usize,
     current: Option<u32>,
     /// Edges that entered so far (a counter for the stats).
     pub entered: u64,
@@ -412,13 +417,13 @@ impl<'a> ActiveEdges<'a> {
         debug_assert!(table.built, "EdgeTable::finish must be called before walking");
         let start = lines.start.max(table.lines.start);
         let end = lines.end.min(table.lines.end);
-        let mut active = Vec::new();
+        let (mut active, mut cursor) = (Vec::new(), 0);
         if start > table.lines.start && start < end {
-            let bucket = |line: u32| table.bucket[(line - table.lines.start) as usize] as usize;
-            let upto = bucket(start);
+            let upto = table.before(start);
+            cursor = upto;
             // Above `near`, only the long edges can reach `start`; taken in index order, the
             // candidates are the same as reading every edge above `start`.
-            let near = bucket(start.saturating_sub(LONG_EDGE).max(table.lines.start));
+            let near = table.before(start.saturating_sub(LONG_EDGE).max(table.lines.start));
             let long = &table.long[..table.long.partition_point(|&i| (i as usize) < near)];
             for i in long.iter().map(|&i| i as usize).chain(near..upto) {
                 let e = &table.edges[i];
@@ -428,7 +433,7 @@ impl<'a> ActiveEdges<'a> {
             }
             active.sort_unstable_by(|a, b| a.x.total_cmp(&b.x));
         }
-        ActiveEdges { table, next: start, end, active, incoming: Vec::new(), current: None, entered: 0 }
+        ActiveEdges { table, next: start, end, active, incoming: Vec::new(), cursor, current: None, entered: 0 }
     }
 
     /// Advances to the next line: its index and its crossings in increasing x.
@@ -470,7 +475,9 @@ impl<'a> ActiveEdges<'a> {
             active[j] = item;
         }
         // Edges that start on this line are sorted among themselves, then merged in.
-        let entering = self.table.starting_on(line);
+        let rest = &self.table.edges[self.cursor..];
+        let entering = &rest[..rest.iter().take_while(|e| e.first == line).count()];
+        self.cursor += entering.len();
         if !entering.is_empty() {
             self.entered += entering.len() as u64;
             self.incoming.clear();

@@ -62,102 +62,111 @@ pub(crate) struct ScreenPolygon {
     /// Index of the scene polygon it came from.
     pub poly: u32,
     /// Its vertices in screen space (one ring; near/far clipping keeps a single ring):
-    /// `Screen::points[start..start + len]`.
+    /// `points[start..start + len]` of its part of the [`Screen`].
     len: u32,
     start: usize,
     /// Its inverse depth over the screen.
     pub depth: DepthPlane,
 }
 
-/// The screen polygons of a view, their rings stored one after another in one buffer (a
-/// million triangles are a million rings: one allocation each would cost more than
-/// clipping them).
+/// How many bits of a screen polygon's number give its place in its part: a part holds at
+/// most `1 << PART_BITS` polygons (those of one chunk of scene polygons).
+const PART_BITS: u32 = 12;
+
+/// The screen polygons of a view, in parts of at most `1 << PART_BITS`, each part's rings
+/// stored one after another in one buffer (a million triangles are a million rings: one
+/// allocation each would cost more than clipping them). The parts are clipped in parallel
+/// and kept as they are, not joined into one list (a second copy of the screen, 43 MB on s3):
+/// a polygon's number is its part's number, then its place in the part ([`PART_BITS`]), so
+/// numbers increase in the order of the scene's polygons but are not all used. The parts are
+/// kept with the screen, so that the next frame clips into memory it already has.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Screen {
-    polygons: Vec<ScreenPolygon>,
-    points: Vec<DVec2>,
-    /// Scratch: each chunk's polygons before they are joined, kept with the screen so that
-    /// the next frame clips into memory it already has.
-    chunks: Vec<Screen>,
+    parts: Vec<Part>,
+    /// The parts in use (the rest are kept memory).
+    used: usize,
 }
 
-impl Screen {
-    /// Adds scene polygon `poly` with its screen `ring` and inverse depth.
-    pub fn push(&mut self, poly: u32, ring: &[DVec2], depth: DepthPlane) {
+/// One part of a [`Screen`].
+#[derive(Debug, Clone, Default)]
+struct Part {
+    polygons: Vec<ScreenPolygon>,
+    points: Vec<DVec2>,
+}
+
+impl Part {
+    fn push(&mut self, poly: u32, ring: &[DVec2], depth: DepthPlane) {
         let start = self.points.len();
         self.points.extend_from_slice(ring);
         self.polygons.push(ScreenPolygon { poly, len: ring.len() as u32, start, depth });
     }
 
-    /// The ring of polygon `p` (one of this screen's).
-    #[inline]
-    pub fn ring(&self, p: &ScreenPolygon) -> &[DVec2] {
-        &self.points[p.start..p.start + p.len as usize]
-    }
-
-    /// Every polygon with its ring.
-    pub fn iter(&self) -> impl Iterator<Item = (&ScreenPolygon, &[DVec2])> {
-        self.polygons.iter().map(|p| (p, self.ring(p)))
-    }
-
-    /// Number of polygons.
-    pub fn len(&self) -> usize {
-        self.polygons.len()
-    }
-
-    /// Empties it, keeping its memory.
     fn clear(&mut self) {
         self.polygons.clear();
         self.points.clear();
     }
+}
 
-    /// Becomes `parts`' polygons one after another, in this screen's memory: each part
-    /// copied into its own stretch, in parallel (a million triangles copied on one thread
-    /// were most of the view's serial time).
-    fn join(&mut self, parts: &[Screen]) {
-        use crate::pieces::{starts, stretches};
-        let placeholder = ScreenPolygon { poly: 0, len: 0, start: 0, depth: DepthPlane { a: 0.0, b: 0.0, c: 0.0 } };
-        let (polygons, points) = (parts.iter().map(Screen::len), parts.iter().map(|p| p.points.len()));
-        self.clear();
-        self.polygons.par_extend(rayon::iter::repeat_n(placeholder, polygons.clone().sum()));
-        self.points.par_extend(rayon::iter::repeat_n(DVec2::ZERO, points.clone().sum()));
-        let shifts = starts(points.clone());
-        stretches(&mut self.polygons, polygons)
-            .into_par_iter()
-            .zip(stretches(&mut self.points, points))
-            .zip(parts)
-            .zip(shifts)
-            .for_each(|(((to_polygons, to_points), part), shift)| {
-                to_points.copy_from_slice(&part.points);
-                for (to, p) in to_polygons.iter_mut().zip(&part.polygons) {
-                    *to = ScreenPolygon { start: p.start + shift, ..*p };
-                }
-            });
+impl Screen {
+    /// Adds scene polygon `poly` with its screen `ring` and inverse depth.
+    pub fn push(&mut self, poly: u32, ring: &[DVec2], depth: DepthPlane) {
+        if self.used == 0 || self.parts[self.used - 1].polygons.len() >> PART_BITS != 0 {
+            if self.parts.len() == self.used {
+                self.parts.push(Part::default());
+            }
+            self.parts[self.used].clear();
+            self.used += 1;
+        }
+        self.parts[self.used - 1].push(poly, ring, depth);
     }
 
-    /// For each band of `band` lines of an image `height` lines high, the polygons (indices,
+    /// Polygon number `i` and its ring.
+    #[inline]
+    pub fn get(&self, i: u32) -> (&ScreenPolygon, &[DVec2]) {
+        let part = &self.parts[(i >> PART_BITS) as usize];
+        let p = &part.polygons[(i & ((1 << PART_BITS) - 1)) as usize];
+        (p, &part.points[p.start..p.start + p.len as usize])
+    }
+
+    /// Every polygon with its number and its ring, in increasing number.
+    pub fn iter(&self) -> impl Iterator<Item = (u32, &ScreenPolygon, &[DVec2])> {
+        self.parts[..self.used].iter().enumerate().flat_map(|(k, part)| {
+            part.polygons.iter().enumerate().map(move |(j, p)| {
+                ((k as u32) << PART_BITS | j as u32, p, &part.points[p.start..p.start + p.len as usize])
+            })
+        })
+    }
+
+    /// Number of polygons.
+    pub fn len(&self) -> usize {
+        self.parts[..self.used].iter().map(|p| p.polygons.len()).sum()
+    }
+
+    /// For each band of `band` lines of an image `height` lines high, the polygons (numbers,
     /// increasing) that reach one of its lines' centres; polygons that reach none are in no
-    /// band. Found in parallel, in chunks of polygons.
+    /// band. Found in parallel, a few parts at a time.
     pub fn band_members(&self, height: u32, band: u32) -> Vec<Vec<u32>> {
-        const CHUNK: usize = 1 << 14;
+        const PARTS: usize = 4;
         let bands = height.div_ceil(band) as usize;
-        let parts: Vec<Vec<Vec<u32>>> = self
-            .polygons
-            .par_chunks(CHUNK)
+        let parts: Vec<Vec<Vec<u32>>> = self.parts[..self.used]
+            .par_chunks(PARTS)
             .enumerate()
-            .map(|(c, chunk)| {
+            .map(|(c, parts)| {
                 let mut lists = vec![Vec::new(); bands];
-                for (i, p) in (c * CHUNK..).zip(chunk) {
-                    let (lo, hi) = self
-                        .ring(p)
-                        .iter()
-                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(q.y), hi.max(q.y)));
-                    let (first, end) = (boundary(lo, height), boundary(hi, height));
-                    if first >= end {
-                        continue;
-                    }
-                    for list in &mut lists[(first / band) as usize..end.div_ceil(band) as usize] {
-                        list.push(i as u32);
+                for (k, part) in (c * PARTS..).zip(parts) {
+                    for (j, p) in part.polygons.iter().enumerate() {
+                        let ring = &part.points[p.start..p.start + p.len as usize];
+                        let (lo, hi) = ring
+                            .iter()
+                            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(q.y), hi.max(q.y)));
+                        let (first, end) = (boundary(lo, height), boundary(hi, height));
+                        if first >= end {
+                            continue;
+                        }
+                        let i = (k as u32) << PART_BITS | j as u32;
+                        for list in &mut lists[(first / band) as usize..end.div_ceil(band) as usize] {
+                            list.push(i);
+                        }
                     }
                 }
                 lists
@@ -176,10 +185,10 @@ impl Screen {
     }
 }
 
-impl std::ops::Index<usize> for Screen {
+impl std::ops::Index<u32> for Screen {
     type Output = ScreenPolygon;
-    fn index(&self, i: usize) -> &ScreenPolygon {
-        &self.polygons[i]
+    fn index(&self, i: u32) -> &ScreenPolygon {
+        self.get(i).0
     }
 }
 
@@ -374,18 +383,21 @@ impl View {
     }
 
     /// The scene polygons `keep` picks that survive clipping, in screen space, in the memory
-    /// of `kept` (a screen of an earlier frame): clipped and projected in parallel, in chunks
-    /// of polygons, then joined in order.
+    /// of `kept` (a screen of an earlier frame): clipped and projected in parallel, a part of
+    /// the screen from each chunk of polygons.
     pub(crate) fn screen_polygons_in(
         &self,
         scene: &Scene,
         keep: impl Fn(usize) -> bool + Sync,
         mut kept: Screen,
     ) -> Screen {
-        const CHUNK: usize = 1 << 12;
-        let mut chunks = std::mem::take(&mut kept.chunks);
-        chunks.resize_with(scene.polygons.len().div_ceil(CHUNK), Screen::default);
-        scene.polygons.par_chunks(CHUNK).zip(chunks.par_iter_mut()).enumerate().for_each(|(c, (polygons, part))| {
+        const CHUNK: usize = 1 << PART_BITS;
+        kept.used = scene.polygons.len().div_ceil(CHUNK);
+        if kept.parts.len() < kept.used {
+            kept.parts.resize_with(kept.used, Part::default);
+        }
+        let parts = &mut kept.parts[..kept.used];
+        scene.polygons.par_chunks(CHUNK).zip(parts.par_iter_mut()).enumerate().for_each(|(c, (polygons, part))| {
             let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
             part.clear();
             for (i, p) in (c * CHUNK..).zip(polygons).filter(|&(i, _)| keep(i)) {
@@ -397,8 +409,6 @@ impl View {
                 }
             }
         });
-        kept.join(&chunks);
-        kept.chunks = chunks;
         kept
     }
 }

@@ -99,7 +99,7 @@ pub fn trace_lines(
     }
     with_stage(scene, &view, shadows, |screen, vis, ctx, stage| {
         let edge = |e: (u32, u32, u32, f64, f64, f64)| {
-            let poly = screen[e.0 as usize].poly;
+            let poly = screen[e.0].poly;
             EdgeTrace {
                 polygon: poly,
                 face: scene.polygons[poly as usize].face,
@@ -128,7 +128,7 @@ pub fn trace_lines(
         let rows = visible.into_iter().zip(entering).zip(leaving);
         for (line, (((runs, spans), entering), leaving)) in lines.clone().zip(rows) {
             walker.start_line(line);
-            let active = aet.advance_to(line).iter().map(|c| (c.x, screen[c.tag as usize].poly)).collect();
+            let active = aet.advance_to(line).iter().map(|c| (c.x, screen[c.tag].poly)).collect();
             let decisions = decide(ctx, walker.as_mut(), line, &runs);
             let shadows = shadows.label();
             emit(LineTrace { line, shadows, entering, leaving, active, spans, runs, decisions })?;

@@ -66,8 +66,8 @@ impl<'a> ScanlineVisibility<'a> {
     /// (what `umbra trace` lists; the walk builds one per band instead).
     pub fn whole_table(&self) -> EdgeTable {
         let mut table = EdgeTable::new(self.height);
-        for (i, (_, ring)) in self.screen.iter().enumerate() {
-            table.add_ring(i as u32, ring);
+        for (i, _, ring) in self.screen.iter() {
+            table.add_ring(i, ring);
         }
         table.finish();
         table
@@ -105,8 +105,8 @@ impl<'a> ScanlineVisibility<'a> {
         planes.clear();
         polys.clear();
         for (k, &i) in members.iter().enumerate() {
-            let p = &self.screen[i as usize];
-            table.add_ring(k as u32, self.screen.ring(p));
+            let (p, ring) = self.screen.get(i);
+            table.add_ring(k as u32, ring);
             planes.push(p.depth);
             polys.push(p.poly);
         }
