@@ -336,6 +336,11 @@ impl EdgeTable {
         self.mark_long(parallel);
     }
 
+    /// Frees the buffer kept for the next sort, for a table that will not be sorted again.
+    pub(crate) fn let_spare_go(&mut self) {
+        self.spare = Vec::new();
+    }
+
     /// Lists the sorted edges longer than [`LONG_EDGE`] lines.
     fn mark_long(&mut self, parallel: bool) {
         self.long.clear();
