@@ -232,14 +232,25 @@ pub(crate) fn even_odd_edges(edges: impl IntoIterator<Item = (DVec2, DVec2)>, p:
 pub(crate) fn grid_cells(
     lo: DVec2,
     size: DVec2,
+    g: (usize, usize),
+    ab: (DVec2, DVec2),
+) -> impl Iterator<Item = (usize, usize)> {
+    let (c0, c1, r0, r1) = grid_rectangle(lo, size, g, ab);
+    (c0..=c1).flat_map(move |c| (r0..=r1).map(move |r| (c, r)))
+}
+
+/// The cells [`grid_cells`] lists, as their first and last column and first and last row.
+pub(crate) fn grid_rectangle(
+    lo: DVec2,
+    size: DVec2,
     (gx, gy): (usize, usize),
     (a, b): (DVec2, DVec2),
-) -> impl Iterator<Item = (usize, usize)> {
+) -> (usize, usize, usize, usize) {
     let cell =
-        move |v: f64, lo: f64, size: f64, g: usize| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
+        |v: f64, lo: f64, size: f64, g: usize| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
     let (c0, c1) = (cell(a.x, lo.x, size.x, gx), cell(b.x, lo.x, size.x, gx));
     let (r0, r1) = (cell(a.y, lo.y, size.y, gy), cell(b.y, lo.y, size.y, gy));
-    (c0..=c1).flat_map(move |c| (r0..=r1).map(move |r| (c, r)))
+    (c0, c1, r0, r1)
 }
 
 /// Directed edges, given by the keys of their ends, chained into closed loops (each a list

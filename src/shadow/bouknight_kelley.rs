@@ -40,7 +40,7 @@ use super::projection::{bounding_rectangle, edge_on, faces_away_on_solid, light_
 use super::{
     BouknightKelleyOptions, Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker,
 };
-use crate::geometry::grid_cells;
+use crate::geometry::grid_rectangle;
 use crate::pool::Pool;
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
@@ -115,17 +115,19 @@ fn shadow_polygons(
     let t = Instant::now();
     let extents = options.prefilter.then(|| Extents::new(scene, sample, &casters, &receivers));
     let (grid, extents) = match extents {
-        Some(e) if options.sphere_grid => (Some(SphereGrid::new(e, scene, &casters)), None),
+        Some(e) if options.sphere_grid => (Some(SphereGrid::new(e, &casters, &receivers)), None),
         e => (None, e),
     };
     counters.add(crate::stats::Counter::PrefilterGridUs, t.elapsed().as_micros() as u64);
 
     // Receivers differ widely in cost, so the loop is cut into pieces of at most
     // `RECEIVERS_PER_PIECE` (rayon's own cut leaves a few long pieces, and a thread that
-    // runs out of work waits for the last); the pieces share their threads' stamps.
+    // runs out of work waits for the last); the pieces share their threads' stamps. Each
+    // piece folds its receivers' results into one `Piece`, in order.
     let stamps = Pool::default();
     let pieces: Vec<Piece> = receivers
-        .par_chunks(RECEIVERS_PER_PIECE)
+        .par_iter()
+        .with_max_len(RECEIVERS_PER_PIECE)
         .map_init(
             || {
                 let mut stamp = stamps.lease();
@@ -135,28 +137,27 @@ fn shadow_polygons(
                 }
                 (Projector::default(), stamp, [Vec::new(), Vec::new()], Vec::new(), Vec::new())
             },
-            |(proj, stamp, scratch, ring, candidates), receivers| {
-                let mut piece = Piece::default();
-                for &b in receivers {
-                    let t = Instant::now();
-                    let mut tested = 0;
-                    match (&grid, &extents) {
-                        (Some(g), _) => g.candidates(b, scene.verts(b as usize), stamp, candidates),
-                        (None, Some(e)) => tested = e.every_pair(b, &casters, candidates),
-                        (None, None) => candidates.clone_from(&casters),
-                    }
-                    let prefilter_ns = t.elapsed().as_nanos() as u64;
-                    let t = Instant::now();
-                    let (mut tally, table, pairs) =
-                        project_onto(ctx, options, sample, b, candidates, proj, scratch, ring);
-                    tally.tested += tested;
-                    tally.prefilter_ns += prefilter_ns;
-                    tally.projection_ns += t.elapsed().as_nanos() as u64;
-                    piece.add(tally, table, pairs, ctx.keep_outlines);
+            |(proj, stamp, scratch, ring, candidates), &b| {
+                let t = Instant::now();
+                let mut tested = 0;
+                match (&grid, &extents) {
+                    (Some(g), _) => g.candidates(b, stamp, candidates),
+                    (None, Some(e)) => tested = e.every_pair(b, &casters, candidates),
+                    (None, None) => candidates.clone_from(&casters),
                 }
-                piece
+                let prefilter_ns = t.elapsed().as_nanos() as u64;
+                let t = Instant::now();
+                let (mut tally, table, pairs) = project_onto(ctx, options, sample, b, candidates, proj, scratch, ring);
+                tally.tested += tested;
+                tally.prefilter_ns += prefilter_ns;
+                tally.projection_ns += t.elapsed().as_nanos() as u64;
+                (tally, table, pairs)
             },
         )
+        .fold(Piece::default, |mut piece, (tally, table, pairs)| {
+            piece.add(tally, table, pairs, ctx.keep_outlines);
+            piece
+        })
         .collect();
     // The grid is let go before the overlay is made (a million polygons' cones).
     drop((grid, extents));
@@ -237,9 +238,10 @@ fn project_onto(
 /// The most receivers one piece of the parallel loop over them takes.
 const RECEIVERS_PER_PIECE: usize = 512;
 
-/// One piece of the loop over receivers: their tallies summed, and their tables. In the
-/// usual frame only the tables that hold shadow polygons are kept (most receivers' are
-/// empty) and the pairs are let go; for traces, every receiver's table and pairs, in order.
+/// What one piece of the loop over receivers made: their tallies summed, and their tables.
+/// In the usual frame only the tables that hold shadow polygons are kept (most receivers'
+/// are empty: a result kept per receiver costs a few hundred bytes each) and the pairs are
+/// let go; for traces, every receiver's table and pairs, in order.
 #[derive(Default)]
 struct Piece {
     tally: Tally,
@@ -388,7 +390,8 @@ impl Extent {
 /// the light (on the plane across a directional light). What the pair test reads is kept, one
 /// entry per polygon: a point light's cones, a directional light's boxes. A point light's
 /// boxes (in polar angle and azimuth) only place polygons in the [`SphereGrid`], which works
-/// them out again where it needs them (kept, they were 80 bytes a polygon).
+/// them out from the cones where it needs them ([`sphere_boxes`]; kept, they would cost 80
+/// bytes a polygon).
 struct Extents {
     /// A directional light: each polygon's box on the plane across the light.
     boxes: Vec<[f64; 4]>,
@@ -408,7 +411,13 @@ impl Extents {
         let of = |i: usize| if wanted[i] { extent(scene.verts(i), sample) } else { Extent::NONE };
         let mut extents = Extents { boxes: Vec::new(), cones: Vec::new(), sample };
         match sample {
-            LightSample::Point(_) => extents.cones.par_extend((0..n).into_par_iter().map(|i| of(i).cone)),
+            LightSample::Point(s) => extents.cones.par_extend((0..n).into_par_iter().map(|i| {
+                if wanted[i] {
+                    cone(scene.verts(i), s)
+                } else {
+                    Extent::NONE.cone
+                }
+            })),
             LightSample::Directional(_) => {
                 let whole = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
                 extents.boxes.par_extend((0..n).into_par_iter().map(|i| of(i).boxes[0].unwrap_or(whole)))
@@ -421,10 +430,15 @@ impl Extents {
         matches!(self.sample, LightSample::Point(_))
     }
 
-    /// Polygon `i`'s boxes (of vertices `verts`).
-    fn boxes_of(&self, i: u32, verts: &[DVec3]) -> Boxes {
+    /// The number of polygons.
+    fn len(&self) -> usize {
+        self.cones.len().max(self.boxes.len())
+    }
+
+    /// Polygon `i`'s boxes (one asked about), from its cone for a point light.
+    fn boxes_of(&self, i: u32) -> Boxes {
         match self.sample {
-            LightSample::Point(_) => extent(verts, self.sample).boxes,
+            LightSample::Point(_) => sphere_boxes(&self.cones[i as usize]),
             LightSample::Directional(_) => [Some(self.boxes[i as usize]), None],
         }
     }
@@ -457,16 +471,25 @@ impl Extents {
 /// so that a receiver meets only the casters in its cells.
 struct SphereGrid {
     extents: Extents,
-    domain: [f64; 4],
     g: usize,
+    /// Each caster's and receiver's cells: one or two rectangles of them (column range,
+    /// then row range, inclusive; an empty one has its first column past its last), found
+    /// once, 16 bytes a polygon.
+    cells: Vec<[Cells; 2]>,
     /// The casters binned in cell `k` (column-major, `c * g + r`) are
     /// `binned[first[k]..first[k + 1]]`, in increasing order.
     first: Vec<u32>,
     binned: Vec<u32>,
 }
 
+/// A rectangle of grid cells: columns `c0..=c1`, rows `r0..=r1`.
+type Cells = [u16; 4];
+
+/// No cells.
+const NO_CELLS: Cells = [1, 0, 1, 0];
+
 impl SphereGrid {
-    fn new(extents: Extents, scene: &Scene, casters: &[u32]) -> Self {
+    fn new(extents: Extents, casters: &[u32], receivers: &[u32]) -> Self {
         let domain = match extents.sample {
             LightSample::Point(_) => [0.0, -PI, PI, PI],
             LightSample::Directional(_) => extents
@@ -478,23 +501,40 @@ impl SphereGrid {
                 }),
         };
         let g = ((casters.len() as f64).sqrt().ceil() as usize).clamp(4, 1024);
-        let mut grid = SphereGrid { extents, domain, g, first: Vec::new(), binned: Vec::new() };
+        let mut wanted = vec![false; extents.len()];
+        for &i in casters.iter().chain(receivers) {
+            wanted[i as usize] = true;
+        }
+        let (lo, size) = (
+            DVec2::new(domain[0], domain[1]),
+            DVec2::new(domain[2] - domain[0], domain[3] - domain[1]).max(DVec2::splat(1e-300)),
+        );
+        let rectangle = |b: Option<[f64; 4]>| {
+            let Some(b) = b else { return NO_CELLS };
+            let (c0, c1, r0, r1) = grid_rectangle(lo, size, (g, g), (DVec2::new(b[0], b[1]), DVec2::new(b[2], b[3])));
+            [c0, c1, r0, r1].map(|k| k as u16)
+        };
+        let cells = (0..wanted.len())
+            .into_par_iter()
+            .map(|i| match wanted[i] {
+                true => extents.boxes_of(i as u32).map(rectangle),
+                false => [NO_CELLS; 2],
+            })
+            .collect();
+        let mut grid = SphereGrid { extents, g, cells, first: Vec::new(), binned: Vec::new() };
         // Every (cell, caster) pair as one key, cell first: each caster counts its cells and
         // fills its own stretch, and the keys are sorted, all by all threads (a million
         // casters' pairs collected and counted into the cells on one thread were most of
         // the grid's time). Each cell lists its casters in increasing order.
-        let boxes: Vec<Boxes> =
-            casters.par_iter().map(|&i| grid.extents.boxes_of(i, scene.verts(i as usize))).collect();
-        let counts: Vec<usize> = boxes.par_iter().map(|b| grid.cells_of(*b).count()).collect();
+        let counts: Vec<usize> = casters.par_iter().map(|&i| grid.cells_of(i).count()).collect();
         let mut keys = vec![0u64; counts.iter().sum()];
-        crate::pieces::stretches(&mut keys, counts.iter().copied()).into_par_iter().zip(casters).zip(&boxes).for_each(
-            |((keys, &i), b)| {
-                for (key, (c, r)) in keys.iter_mut().zip(grid.cells_of(*b)) {
+        crate::pieces::stretches(&mut keys, counts.iter().copied()).into_par_iter().zip(casters).for_each(
+            |(keys, &i)| {
+                for (key, (c, r)) in keys.iter_mut().zip(grid.cells_of(i)) {
                     *key = ((c * g + r) as u64) << 32 | i as u64;
                 }
             },
         );
-        drop(boxes);
         keys.par_sort_unstable();
         let mut first = vec![0u32; g * g + 1];
         let mut cell = 0;
@@ -516,22 +556,21 @@ impl SphereGrid {
         &self.binned[self.first[k] as usize..self.first[k + 1] as usize]
     }
 
-    /// The grid cells (column, row) that an extent's `boxes` touch.
-    fn cells_of(&self, boxes: Boxes) -> impl Iterator<Item = (usize, usize)> + '_ {
-        let d = self.domain;
-        let (lo, size) = (DVec2::new(d[0], d[1]), DVec2::new(d[2] - d[0], d[3] - d[1]).max(DVec2::splat(1e-300)));
-        let g = self.g;
-        let boxes = boxes.into_iter().flatten();
-        boxes.flat_map(move |b| grid_cells(lo, size, (g, g), (DVec2::new(b[0], b[1]), DVec2::new(b[2], b[3]))))
+    /// The grid cells (column, row) that polygon `i`'s extent touches (a caster or a
+    /// receiver).
+    fn cells_of(&self, i: u32) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.cells[i as usize].iter().flat_map(|&[c0, c1, r0, r1]| {
+            (c0 as usize..=c1 as usize).flat_map(move |c| (r0 as usize..=r1 as usize).map(move |r| (c, r)))
+        })
     }
 
-    /// The casters whose extents overlap receiver `b`'s (of vertices `verts`): those sharing
-    /// a grid cell with it whose bounding cones overlap (for a point light; shared cells
-    /// suffice for a directional light, whose boxes are the cells' own test). `stamp` is
-    /// scratch, one entry per polygon, that keeps each caster from being listed twice.
-    fn candidates(&self, b: u32, verts: &[DVec3], stamp: &mut [u32], out: &mut Vec<u32>) {
+    /// The casters whose extents overlap receiver `b`'s: those sharing a grid cell with it
+    /// whose bounding cones overlap (for a point light; shared cells suffice for a
+    /// directional light, whose boxes are the cells' own test). `stamp` is scratch, one entry
+    /// per polygon, that keeps each caster from being listed twice.
+    fn candidates(&self, b: u32, stamp: &mut [u32], out: &mut Vec<u32>) {
         out.clear();
-        for (c, r) in self.cells_of(self.extents.boxes_of(b, verts)) {
+        for (c, r) in self.cells_of(b) {
             for &a in self.cell(c, r) {
                 if stamp[a as usize] == b {
                     continue;
@@ -554,34 +593,8 @@ impl SphereGrid {
 fn extent(verts: &[DVec3], sample: LightSample) -> Extent {
     match sample {
         LightSample::Point(s) => {
-            let full = Extent { boxes: [Some([0.0, -PI, PI, PI]), None], cone: Cone::new(DVec3::Y, PI) };
-            let dirs: smallvec::SmallVec<[DVec3; 8]> = verts.iter().map(|&v| (v - s).normalize_or_zero()).collect();
-            let axis = dirs.iter().sum::<DVec3>().normalize_or_zero();
-            if axis == DVec3::ZERO || dirs.contains(&DVec3::ZERO) {
-                return full;
-            }
-            // The widest vertex direction's angle: the arccosine of the least cosine.
-            let least = dirs.iter().map(|d| d.dot(axis)).fold(1.0, f64::min).clamp(-1.0, 1.0);
-            let half = least.acos() + 1e-9;
-            if half >= PI / 2.0 {
-                return full;
-            }
-            let theta = axis.y.clamp(-1.0, 1.0).acos();
-            let phi = axis.z.atan2(axis.x);
-            let (t0, t1) = (theta - half, theta + half);
-            if t0 <= 0.0 || t1 >= PI {
-                return Extent { boxes: [Some([t0.max(0.0), -PI, t1.min(PI), PI]), None], cone: Cone::new(axis, half) };
-            }
-            let dphi = (half.sin() / theta.sin()).min(1.0).asin() + 1e-9;
-            let (p0, p1) = (phi - dphi, phi + dphi);
-            let boxes = if p0 < -PI {
-                [Some([t0, p0 + 2.0 * PI, t1, PI]), Some([t0, -PI, t1, p1])]
-            } else if p1 > PI {
-                [Some([t0, p0, t1, PI]), Some([t0, -PI, t1, p1 - 2.0 * PI])]
-            } else {
-                [Some([t0, p0, t1, p1]), None]
-            };
-            Extent { boxes, cone: Cone::new(axis, half) }
+            let cone = cone(verts, s);
+            Extent { boxes: sphere_boxes(&cone), cone }
         }
         LightSample::Directional(d) => {
             let u = d.any_orthonormal_vector();
@@ -592,6 +605,48 @@ fn extent(verts: &[DVec3], sample: LightSample) -> Extent {
             });
             Extent { boxes: [Some(b), None], cone: Cone::new(d, PI) }
         }
+    }
+}
+
+/// The bounding cone, from a point light at `s`, of the directions to `verts` (the whole
+/// sphere where they do not fit in a cone under 90°).
+fn cone(verts: &[DVec3], s: DVec3) -> Cone {
+    let full = Cone::new(DVec3::Y, PI);
+    let dirs: smallvec::SmallVec<[DVec3; 8]> = verts.iter().map(|&v| (v - s).normalize_or_zero()).collect();
+    let axis = dirs.iter().sum::<DVec3>().normalize_or_zero();
+    if axis == DVec3::ZERO || dirs.contains(&DVec3::ZERO) {
+        return full;
+    }
+    // The widest vertex direction's angle: the arccosine of the least cosine.
+    let least = dirs.iter().map(|d| d.dot(axis)).fold(1.0, f64::min).clamp(-1.0, 1.0);
+    let half = least.acos() + 1e-9;
+    if half >= PI / 2.0 {
+        return full;
+    }
+    Cone::new(axis, half)
+}
+
+/// A cone's boxes in polar angle θ (from +Y) and azimuth φ (two where the azimuth wraps;
+/// the whole domain for the whole sphere).
+fn sphere_boxes(cone: &Cone) -> Boxes {
+    let (axis, half) = (cone.axis, cone.half);
+    if half >= PI / 2.0 {
+        return [Some([0.0, -PI, PI, PI]), None];
+    }
+    let theta = axis.y.clamp(-1.0, 1.0).acos();
+    let phi = axis.z.atan2(axis.x);
+    let (t0, t1) = (theta - half, theta + half);
+    if t0 <= 0.0 || t1 >= PI {
+        return [Some([t0.max(0.0), -PI, t1.min(PI), PI]), None];
+    }
+    let dphi = (half.sin() / theta.sin()).min(1.0).asin() + 1e-9;
+    let (p0, p1) = (phi - dphi, phi + dphi);
+    if p0 < -PI {
+        [Some([t0, p0 + 2.0 * PI, t1, PI]), Some([t0, -PI, t1, p1])]
+    } else if p1 > PI {
+        [Some([t0, p0, t1, PI]), Some([t0, -PI, t1, p1 - 2.0 * PI])]
+    } else {
+        [Some([t0, p0, t1, p1]), None]
     }
 }
 
@@ -762,11 +817,11 @@ mod tests {
             let n = scene.polygons.len();
             let casters: Vec<u32> = (0..n as u32).collect();
             let sample = LightSample::Point(light);
-            let grid = SphereGrid::new(Extents::new(&scene, sample, &casters, &casters), &scene, &casters);
+            let grid = SphereGrid::new(Extents::new(&scene, sample, &casters, &casters), &casters, &casters);
             let mut stamp = vec![u32::MAX; n];
             let (mut found, mut kept) = (0, Vec::new());
             for b in 0..n as u32 {
-                grid.candidates(b, scene.verts(b as usize), &mut stamp, &mut kept);
+                grid.candidates(b, &mut stamp, &mut kept);
                 let t = scene.verts(b as usize);
                 for _ in 0..200 {
                     let (u, v) = (rng.gen_range(0.0..1.0f64), rng.gen_range(0.0..1.0f64));
