@@ -599,16 +599,21 @@ struct Apart {
     verts: Vec<DVec3>,
 }
 
-/// One merged polygon's edge, to be sorted by its two end positions: the first coordinate's
-/// bits of the lesser end (most edges differ there), then the rest read from the corners.
-/// Sixteen bytes an edge, not a copy of both positions: s3's three million edges sort in
-/// 48 MB.
+/// One merged polygon's edge, to be grouped by its two end positions: sorted by a hash of
+/// them, then checked against the positions read from the corners. Sixteen bytes an edge,
+/// not a copy of both positions: s3's three million edges sort in 48 MB.
 #[derive(Clone, Copy)]
 struct KeyedEdge {
-    lead: u64,
+    hash: u64,
     /// The corner (an index into the scene's vertices) the edge starts from.
     corner: u32,
     poly: u32,
+}
+
+/// A hash of an edge's end positions' bits, the lesser end first (a fixed mix, so that the
+/// order of the merged edges is the same on every run).
+fn edge_hash(a: [u64; 3], b: [u64; 3]) -> u64 {
+    a.iter().chain(&b).fold(0u64, |h, &w| (h.rotate_left(5) ^ w).wrapping_mul(0x517c_c1b7_2722_0a95))
 }
 
 /// The bits of a position, by which edges are welded and ordered.
@@ -658,7 +663,7 @@ impl Adjacency {
                 for k in 0..verts.len() {
                     let (a, b) = (bits(verts[k]), bits(verts[(k + 1) % verts.len()]));
                     let corner = poly.start + k as u32;
-                    keyed.push(KeyedEdge { lead: a.min(b)[0], corner, poly: p as u32 });
+                    keyed.push(KeyedEdge { hash: edge_hash(a.min(b), a.max(b)), corner, poly: p as u32 });
                 }
             }
         }
@@ -684,7 +689,8 @@ impl Adjacency {
     }
 
     /// Groups the keyed edges by position: one merged edge each, with the polygons on it, in
-    /// the order of their end positions' bits (sorted by all threads).
+    /// the order of their hashes (sorted by all threads; edges whose hashes collide are
+    /// told apart by their positions).
     fn group(&mut self, scene: &crate::scene::Scene, mut keyed: Vec<KeyedEdge>) {
         // The edge's ends as corners (indices into the scene's vertices), the lesser first,
         // and whether the polygon runs it that way.
@@ -701,16 +707,21 @@ impl Adjacency {
             let (a, b, _) = ends(k);
             (bits(scene.vertices[a as usize]), bits(scene.vertices[b as usize]))
         };
-        keyed.par_sort_unstable_by(|x, y| x.lead.cmp(&y.lead).then_with(|| key(x).cmp(&key(y))));
-        let distinct = keyed.par_windows(2).filter(|w| w[0].lead != w[1].lead || key(&w[0]) != key(&w[1])).count();
-        self.edges.reserve_exact(distinct + 1);
+        keyed.par_sort_unstable_by_key(|k| (k.hash, k.corner));
+        // A run of one hash holding more than one edge position (a collision) is sorted by
+        // position, so that each position's edges lie together.
+        for run in keyed.chunk_by_mut(|x, y| x.hash == y.hash).filter(|run| run.len() > 1) {
+            if run.iter().any(|k| key(k) != key(&run[0])) {
+                run.sort_by(|x, y| key(x).cmp(&key(y)).then(x.corner.cmp(&y.corner)));
+            }
+        }
+        let same = |x: &KeyedEdge, y: &KeyedEdge| x.hash == y.hash && key(x) == key(y);
+        let distinct = 1 + keyed.par_windows(2).filter(|w| !same(&w[0], &w[1])).count();
+        self.edges.reserve_exact(distinct);
         self.sharing.reserve_exact(keyed.len());
-        let mut last = None;
-        for k in &keyed {
+        for (i, k) in keyed.iter().enumerate() {
             let (a, b, forward) = ends(k);
-            let here = key(k);
-            if last != Some(here) {
-                last = Some(here);
+            if i == 0 || !same(&keyed[i - 1], k) {
                 let first = self.sharing.len() as u32;
                 self.edges.push(MergedEdge { a, b, first, count: 0 });
             }
