@@ -44,11 +44,16 @@ struct Edge {
     first: u32,
     end: u32,
     tag: u32,
+    /// Its place in the order edges were added, in a table sorted where it lies (see
+    /// [`EdgeTable::one_frame`]; it fills the struct's padding).
+    seq: u32,
 }
+
+const _: () = assert!(std::mem::size_of::<Edge>() == 40);
 
 impl Edge {
     /// A placeholder, overwritten before it is read.
-    const NONE: Edge = Edge { x_top: 0.0, y_top: 0.0, dxdy: 0.0, first: 0, end: 0, tag: 0 };
+    const NONE: Edge = Edge { x_top: 0.0, y_top: 0.0, dxdy: 0.0, first: 0, end: 0, tag: 0, seq: 0 };
 
     /// The edge from `a` to `b` in an image `height` lines high; `None` when it is
     /// horizontal, not finite, or active on no line.
@@ -60,7 +65,7 @@ impl Edge {
         // The pixel-centre rule down the screen is the rule across it.
         let (first, end) = (boundary(top.y, height), boundary(bot.y, height));
         let dxdy = (bot.x - top.x) / (bot.y - top.y);
-        (first < end).then_some(Edge { x_top: top.x, y_top: top.y, dxdy, first, end, tag })
+        (first < end).then_some(Edge { x_top: top.x, y_top: top.y, dxdy, first, end, tag, seq: 0 })
     }
 
     /// The edge, cut to `lines` when given; none when nothing of it is left.
@@ -150,6 +155,8 @@ pub struct EdgeTable {
     spare: Vec<Edge>,
     /// The lines edges are cut to, if any ([`EdgeTable::clear_to`]).
     within: Option<Range<u32>>,
+    /// Sorted where it lies, with no second buffer ([`EdgeTable::one_frame`]).
+    in_place: bool,
 }
 
 /// The edges of the closed `ring` of polygon `tag`, in order, in an image `height` lines
@@ -210,6 +217,15 @@ impl EdgeTable {
         EdgeTable { height, ..Default::default() }
     }
 
+    /// An empty table for an image `height` lines high that is sorted once and dropped (a
+    /// receiver's shadow polygons): its edges are numbered as they are added and sorted where
+    /// they lie by line and number, by all threads when there are many, instead of scattered
+    /// into a second buffer kept for the next frame (s3's floor holds a million shadow
+    /// polygons' edges, 40 MB).
+    pub fn one_frame(height: u32) -> Self {
+        EdgeTable { height, in_place: true, ..Default::default() }
+    }
+
     /// Empties the table, keeping its memory, for an image `height` lines high.
     pub fn clear(&mut self, height: u32) {
         self.edges.clear();
@@ -232,7 +248,13 @@ impl EdgeTable {
     /// Adds the edges of a closed ring of polygon `tag`. Rings of one tag combine by the
     /// even-odd rule.
     pub fn add_ring(&mut self, tag: u32, ring: &[DVec2]) {
+        let start = self.edges.len();
         self.edges.extend(ring_edges(tag, ring, self.height, &self.within));
+        if self.in_place {
+            for (seq, e) in (start as u32..).zip(&mut self.edges[start..]) {
+                e.seq = seq;
+            }
+        }
         self.built = false;
     }
 
@@ -257,6 +279,9 @@ impl EdgeTable {
                 *slot = e;
             }
         });
+        if self.in_place {
+            self.edges[start..].par_iter_mut().enumerate().for_each(|(k, e)| e.seq = (start + k) as u32);
+        }
         self.built = false;
     }
 
@@ -291,6 +316,10 @@ impl EdgeTable {
             // (half a million receivers' small tables each kept both, 80 MB on s3).
             self.edges.sort_by_key(|e| e.first);
             self.mark_long(false);
+            return;
+        }
+        if self.in_place {
+            self.sort_in_place(parallel);
             return;
         }
         let n = (self.lines.end - lo) as usize;
@@ -336,9 +365,18 @@ impl EdgeTable {
         self.mark_long(parallel);
     }
 
-    /// Frees the buffer kept for the next sort, for a table that will not be sorted again.
-    pub(crate) fn let_spare_go(&mut self) {
-        self.spare = Vec::new();
+    /// Sorts a [`EdgeTable::one_frame`] table where it lies, by first line and then the
+    /// order added (the order the buckets give), and finds its buckets.
+    fn sort_in_place(&mut self, parallel: bool) {
+        let key = |e: &Edge| (e.first, e.seq);
+        if parallel {
+            self.edges.par_sort_unstable_by_key(key);
+        } else {
+            self.edges.sort_unstable_by_key(key);
+        }
+        let lo = self.lines.start;
+        self.bucket.extend((lo..=self.lines.end).map(|line| self.edges.partition_point(|e| e.first < line) as u32));
+        self.mark_long(parallel);
     }
 
     /// Lists the sorted edges longer than [`LONG_EDGE`] lines.
@@ -808,10 +846,10 @@ mod tests {
                 (0..3).map(|_| at + DVec2::new(rng.gen_range(0.0..20.0), rng.gen_range(0.0..60.0))).collect()
             })
             .collect();
-        let sorted_by = |threads: usize| {
+        let sorted_by = |threads: usize, one_frame: bool| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let mut t = EdgeTable::new(1080);
+                let mut t = if one_frame { EdgeTable::one_frame(1080) } else { EdgeTable::new(1080) };
                 t.add_rings(rings.as_slice());
                 t.finish();
                 assert!(t.len() >= PARALLEL_SORT);
@@ -822,18 +860,23 @@ mod tests {
                 )
             })
         };
-        let one = sorted_by(1);
+        let one = sorted_by(1, false);
         for threads in [2, 3] {
-            assert_eq!(sorted_by(threads), one, "{threads} threads");
+            assert_eq!(sorted_by(threads, false), one, "{threads} threads");
         }
-        // And the table that adding the rings one by one builds.
-        let mut by_one = EdgeTable::new(1080);
-        for (tag, ring) in rings.iter().enumerate() {
-            by_one.add_ring(tag as u32, ring);
+        // A table sorted where it lies, by one thread or several, is the same table.
+        for threads in [1, 2] {
+            assert_eq!(sorted_by(threads, true), one, "{threads} threads, sorted where it lies");
         }
-        by_one.finish();
-        let listed: Vec<_> = by_one.edges().map(|e| (e.0, e.1, e.2, e.3.to_bits())).collect();
-        assert_eq!((listed, by_one.bucket.clone(), by_one.long.clone()), one);
+        // And the table that adding the rings one by one builds, either way.
+        for mut by_one in [EdgeTable::new(1080), EdgeTable::one_frame(1080)] {
+            for (tag, ring) in rings.iter().enumerate() {
+                by_one.add_ring(tag as u32, ring);
+            }
+            by_one.finish();
+            let listed: Vec<_> = by_one.edges().map(|e| (e.0, e.1, e.2, e.3.to_bits())).collect();
+            assert_eq!((listed, by_one.bucket.clone(), by_one.long.clone()), one);
+        }
         // Stable: each line's edges in the order they were added (by tag, as added).
         let edges = &one.0;
         assert!(edges.windows(2).all(|w| (w[0].1, w[0].0) <= (w[1].1, w[1].0)));

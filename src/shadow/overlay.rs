@@ -68,7 +68,7 @@ impl ReceiverTable {
     /// No polygons yet on scene polygon `receiver`, in an image `height` lines high;
     /// `keep_rings` keeps their outlines.
     pub fn new(receiver: u32, height: u32, keep_rings: bool) -> Self {
-        ReceiverTable { receiver, table: EdgeTable::new(height), count: 0, rings: Vec::new(), keep_rings }
+        ReceiverTable { receiver, table: EdgeTable::one_frame(height), count: 0, rings: Vec::new(), keep_rings }
     }
 
     /// Adds a polygon with several rings (holes by the even-odd rule).
@@ -102,12 +102,10 @@ impl ReceiverTable {
         self.count as usize
     }
 
-    /// Sorts the edge table; call once after the last polygon. A receiver's table lives
-    /// one frame, so the sort's second buffer is let go (the floor of s3 takes a million
-    /// shadow polygons' edges: 40 MB).
+    /// Sorts the edge table (where it lies: it lives one frame); call once after the last
+    /// polygon.
     pub fn finish(&mut self) {
         self.table.finish();
-        self.table.let_spare_go();
     }
 }
 
