@@ -717,24 +717,29 @@ impl Mapped {
     /// parallel, in order.
     fn new(scene: &Scene, unseen: impl Fn(usize) -> bool + Sync, view: LightView, extent: f64) -> Mapped {
         let n = scene.polygons.len();
-        let parts: Vec<Mapped> = (0..n.div_ceil(MAP_PIECE))
+        let mut parts: Vec<Mapped> = (0..n.div_ceil(MAP_PIECE))
             .into_par_iter()
             .map(|k| {
                 let (mut m, mut scratch) = (Mapped::default(), [Vec::new(), Vec::new()]);
                 for i in (k * MAP_PIECE..n.min((k + 1) * MAP_PIECE)).filter(|&i| !unseen(i)) {
                     m.push(scene, view, i, 1e-9 * extent, &mut scratch);
                 }
+                // The parts and the joined view exist at once: no part keeps room to spare.
+                m.points.shrink_to_fit();
+                m.polys.shrink_to_fit();
                 m
             })
             .collect();
         // Each part's outlines start where the parts before it end.
         let base = pieces::starts(parts.iter().map(|m| m.points.len()));
-        let points: Vec<&[DVec2]> = parts.iter().map(|m| &m.points[..]).collect();
         let polys: Vec<&[MappedPolygon]> = parts.iter().map(|m| &m.polys[..]).collect();
-        Mapped {
-            points: pieces::joined(&points, |_, &p| p),
-            polys: pieces::joined(&polys, |k, &p| MappedPolygon { first: p.first + base[k] as u32, ..p }),
+        let polys = pieces::joined(&polys, |k, &p| MappedPolygon { first: p.first + base[k] as u32, ..p });
+        // The parts' polygons are let go before their outlines are joined.
+        for part in &mut parts {
+            part.polys = Vec::new();
         }
+        let points: Vec<&[DVec2]> = parts.iter().map(|m| &m.points[..]).collect();
+        Mapped { points: pieces::joined(&points, |_, &p| p), polys }
     }
 
     /// Maps polygon `i` of `scene`, if the view sees any of it.

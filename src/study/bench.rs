@@ -378,9 +378,9 @@ fn wait_for_quiet(cores: usize) -> bool {
     false
 }
 
-/// The peak resident set of this process in MB (`VmHWM` in `/proc/self/status`; 0 where
-/// there is no such file).
-fn peak_rss_mb() -> f64 {
+/// The peak resident set of this process in MB of 2²⁰ bytes (`VmHWM` in
+/// `/proc/self/status`; 0 where there is no such file).
+pub fn peak_rss_mb() -> f64 {
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
     status
         .lines()

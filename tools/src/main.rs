@@ -438,8 +438,9 @@ struct RenderArgs {
     /// counters in false colour: depth_complexity.png, span_splits.png, shadow_tests.png.
     #[arg(long, value_name = "DIR")]
     aov: Option<PathBuf>,
-    /// Print the counters and times as one JSON object on standard output (for williams,
-    /// with `map_errors`: its wrong interior pixels by cause, against ray-cast; two more renders).
+    /// Print the counters and times as one JSON object on standard output, with the
+    /// process's peak resident memory (`peak_rss_mb`, MB of 2^20 bytes); for williams, with
+    /// `map_errors`: its wrong interior pixels by cause, against ray-cast (two more renders).
     #[arg(long)]
     stats: bool,
     /// Encode the image with this display gamma (0.1 to 10, for example 2.2); default:
@@ -814,6 +815,9 @@ fn render_command(a: RenderArgs) -> umbra::Result<()> {
     if a.stats {
         let internal = |e: serde_json::Error| Error::Internal(e.to_string());
         let mut json = serde_json::to_value(&out.stats).map_err(internal)?;
+        // The process's high-water mark: the scene, the frame and the stage's working memory
+        // at their most (taken before `map_errors` renders more).
+        json["peak_rss_mb"] = serde_json::json!(umbra::study::bench::peak_rss_mb());
         if let Some(errors) = map_errors(&scene, &opts, &out.frame)? {
             json["map_errors"] = serde_json::to_value(errors).map_err(internal)?;
         }

@@ -32,6 +32,8 @@ fn render_writes_image_aovs_and_stats() {
     let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(stats["visibility"], "zbuffer");
     assert!(stats["shadow_counters"]["shadow_rays"].as_u64().unwrap() > 0);
+    // The process's peak resident memory: more than the 640×480 frame's buffers alone.
+    assert!(stats["peak_rss_mb"].as_f64().unwrap() > 1.0);
     let id = image::open(d.join("aov/id.png")).unwrap().to_rgba8();
     assert_eq!(id.dimensions(), (640, 480));
     // Top-left corner is background.
