@@ -730,6 +730,9 @@ impl Adjacency {
                 e.count += 1;
             }
         }
+        // In the order of their first corners, so that a pass over the edges reads the
+        // scene's vertices in order, not at random as the hashes fall.
+        self.edges.par_sort_unstable_by_key(|e| (e.a, e.b));
     }
 }
 
