@@ -115,7 +115,7 @@ fn shadow_polygons(
     let t = Instant::now();
     let extents = options.prefilter.then(|| Extents::new(scene, sample, &casters, &receivers));
     let (grid, extents) = match extents {
-        Some(e) if options.sphere_grid => (Some(SphereGrid::new(e, &casters, &receivers)), None),
+        Some(e) if options.sphere_grid => (Some(SphereGrid::new(e, &casters)), None),
         e => (None, e),
     };
     counters.add(crate::stats::Counter::PrefilterGridUs, t.elapsed().as_micros() as u64);
@@ -352,16 +352,7 @@ impl Wedge {
     }
 }
 
-/// A polygon's extent as the light sees it.
-#[derive(Debug, Clone, Copy)]
-struct Extent {
-    /// Boxes in the 2D domain of the [`SphereGrid`] (two when the azimuth wraps).
-    boxes: Boxes,
-    /// Point lights: the bounding cone (a half-angle of π covers everything).
-    cone: Cone,
-}
-
-/// An extent's boxes in the 2D domain of the [`SphereGrid`].
+/// An extent's boxes in the 2D domain of the [`SphereGrid`] (two when the azimuth wraps).
 type Boxes = [Option<[f64; 4]>; 2];
 
 /// A bounding cone from the light: its axis, its half-angle, and the half-angle's cosine
@@ -376,14 +367,12 @@ struct Cone {
 }
 
 impl Cone {
+    /// The cone of a polygon that is neither caster nor receiver (never asked about).
+    const NONE: Cone = Cone { axis: DVec3::Y, half: 0.0, cos: 1.0, sin: 0.0 };
+
     fn new(axis: DVec3, half: f64) -> Cone {
         Cone { axis, half, cos: half.cos(), sin: half.sin() }
     }
-}
-
-impl Extent {
-    /// The extent of a polygon that is neither caster nor receiver (never asked about).
-    const NONE: Extent = Extent { boxes: [None, None], cone: Cone { axis: DVec3::Y, half: 0.0, cos: 1.0, sin: 0.0 } };
 }
 
 /// Step 2, the sphere prefilter: every caster's and receiver's extent on the sphere around
@@ -397,6 +386,8 @@ struct Extents {
     boxes: Vec<[f64; 4]>,
     /// A point light: each polygon's cone.
     cones: Vec<Cone>,
+    /// The polygons asked about: the casters and the receivers.
+    wanted: Vec<bool>,
     sample: LightSample,
 }
 
@@ -408,31 +399,17 @@ impl Extents {
         for &i in casters.iter().chain(receivers) {
             wanted[i as usize] = true;
         }
-        let of = |i: usize| if wanted[i] { extent(scene.verts(i), sample) } else { Extent::NONE };
-        let mut extents = Extents { boxes: Vec::new(), cones: Vec::new(), sample };
+        let (mut boxes, mut cones) = (Vec::new(), Vec::new());
+        let asked = (0..n).into_par_iter().map(|i| wanted[i].then(|| scene.verts(i)));
         match sample {
-            LightSample::Point(s) => extents.cones.par_extend((0..n).into_par_iter().map(|i| {
-                if wanted[i] {
-                    cone(scene.verts(i), s)
-                } else {
-                    Extent::NONE.cone
-                }
-            })),
-            LightSample::Directional(_) => {
-                let whole = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
-                extents.boxes.par_extend((0..n).into_par_iter().map(|i| of(i).boxes[0].unwrap_or(whole)))
-            }
+            LightSample::Point(s) => cones.par_extend(asked.map(|v| v.map_or(Cone::NONE, |v| cone(v, s)))),
+            LightSample::Directional(d) => boxes.par_extend(asked.map(|v| v.map_or(NO_BOX, |v| plane_box(v, d)))),
         }
-        extents
+        Extents { boxes, cones, wanted, sample }
     }
 
     fn point(&self) -> bool {
         matches!(self.sample, LightSample::Point(_))
-    }
-
-    /// The number of polygons.
-    fn len(&self) -> usize {
-        self.cones.len().max(self.boxes.len())
     }
 
     /// Polygon `i`'s boxes (one asked about), from its cone for a point light.
@@ -489,7 +466,7 @@ type Cells = [u16; 4];
 const NO_CELLS: Cells = [1, 0, 1, 0];
 
 impl SphereGrid {
-    fn new(extents: Extents, casters: &[u32], receivers: &[u32]) -> Self {
+    fn new(extents: Extents, casters: &[u32]) -> Self {
         let domain = match extents.sample {
             LightSample::Point(_) => [0.0, -PI, PI, PI],
             LightSample::Directional(_) => extents
@@ -501,10 +478,6 @@ impl SphereGrid {
                 }),
         };
         let g = ((casters.len() as f64).sqrt().ceil() as usize).clamp(4, 1024);
-        let mut wanted = vec![false; extents.len()];
-        for &i in casters.iter().chain(receivers) {
-            wanted[i as usize] = true;
-        }
         let (lo, size) = (
             DVec2::new(domain[0], domain[1]),
             DVec2::new(domain[2] - domain[0], domain[3] - domain[1]).max(DVec2::splat(1e-300)),
@@ -514,9 +487,9 @@ impl SphereGrid {
             let (c0, c1, r0, r1) = grid_rectangle(lo, size, (g, g), (DVec2::new(b[0], b[1]), DVec2::new(b[2], b[3])));
             [c0, c1, r0, r1].map(|k| k as u16)
         };
-        let cells = (0..wanted.len())
+        let cells = (0..extents.wanted.len())
             .into_par_iter()
-            .map(|i| match wanted[i] {
+            .map(|i| match extents.wanted[i] {
                 true => extents.boxes_of(i as u32).map(rectangle),
                 false => [NO_CELLS; 2],
             })
@@ -586,30 +559,22 @@ impl SphereGrid {
     }
 }
 
-/// A polygon's extent: for a point light, the cone from the light around the directions to
-/// its vertices (a polygon's directions all lie inside a cone of half-angle under 90° that
-/// holds its vertices' directions), as boxes in polar angle θ (from +Y) and azimuth φ; for a
-/// directional light, the box of its vertices on the plane across the light.
-fn extent(verts: &[DVec3], sample: LightSample) -> Extent {
-    match sample {
-        LightSample::Point(s) => {
-            let cone = cone(verts, s);
-            Extent { boxes: sphere_boxes(&cone), cone }
-        }
-        LightSample::Directional(d) => {
-            let u = d.any_orthonormal_vector();
-            let v = d.cross(u);
-            let b = verts.iter().fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |b, p| {
-                let (x, y) = (p.dot(u), p.dot(v));
-                [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)]
-            });
-            Extent { boxes: [Some(b), None], cone: Cone::new(d, PI) }
-        }
-    }
+/// No box: a polygon never asked about (its first coordinate past its last).
+const NO_BOX: [f64; 4] = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+
+/// The box of `verts` on the plane across a directional light along `d`.
+fn plane_box(verts: &[DVec3], d: DVec3) -> [f64; 4] {
+    let u = d.any_orthonormal_vector();
+    let v = d.cross(u);
+    verts.iter().fold(NO_BOX, |b, p| {
+        let (x, y) = (p.dot(u), p.dot(v));
+        [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)]
+    })
 }
 
-/// The bounding cone, from a point light at `s`, of the directions to `verts` (the whole
-/// sphere where they do not fit in a cone under 90°).
+/// The bounding cone, from a point light at `s`, of the directions to `verts` (a polygon's
+/// directions all lie inside a cone of half-angle under 90° that holds its vertices'
+/// directions; the whole sphere where they do not fit in one).
 fn cone(verts: &[DVec3], s: DVec3) -> Cone {
     let full = Cone::new(DVec3::Y, PI);
     let dirs: smallvec::SmallVec<[DVec3; 8]> = verts.iter().map(|&v| (v - s).normalize_or_zero()).collect();
@@ -817,7 +782,7 @@ mod tests {
             let n = scene.polygons.len();
             let casters: Vec<u32> = (0..n as u32).collect();
             let sample = LightSample::Point(light);
-            let grid = SphereGrid::new(Extents::new(&scene, sample, &casters, &casters), &casters, &casters);
+            let grid = SphereGrid::new(Extents::new(&scene, sample, &casters, &casters), &casters);
             let mut stamp = vec![u32::MAX; n];
             let (mut found, mut kept) = (0, Vec::new());
             for b in 0..n as u32 {
