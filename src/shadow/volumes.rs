@@ -688,9 +688,9 @@ impl Adjacency {
         }
     }
 
-    /// Groups the keyed edges by position: one merged edge each, with the polygons on it, in
-    /// the order of their hashes (sorted by all threads; edges whose hashes collide are
-    /// told apart by their positions).
+    /// Groups the keyed edges by position: one merged edge each, with the polygons on it
+    /// (the keys sorted by their hashes, by all threads; edges whose hashes collide are told
+    /// apart by their positions), the merged edges in the order of their first corners.
     fn group(&mut self, scene: &crate::scene::Scene, mut keyed: Vec<KeyedEdge>) {
         // The edge's ends as corners (indices into the scene's vertices), the lesser first,
         // and whether the polygon runs it that way.
