@@ -690,7 +690,8 @@ impl Adjacency {
 
     /// Groups the keyed edges by position: one merged edge each, with the polygons on it
     /// (the keys sorted by their hashes, by all threads; edges whose hashes collide are told
-    /// apart by their positions), the merged edges in the order of their first corners.
+    /// apart by their positions), the merged edges and the polygons on them in the order of
+    /// their first corners.
     fn group(&mut self, scene: &crate::scene::Scene, mut keyed: Vec<KeyedEdge>) {
         // The edge's ends as corners (indices into the scene's vertices), the lesser first,
         // and whether the polygon runs it that way.
@@ -715,13 +716,24 @@ impl Adjacency {
                 run.sort_by(|x, y| key(x).cmp(&key(y)).then(x.corner.cmp(&y.corner)));
             }
         }
-        let same = |x: &KeyedEdge, y: &KeyedEdge| x.hash == y.hash && key(x) == key(y);
-        let distinct = 1 + keyed.par_windows(2).filter(|w| !same(&w[0], &w[1])).count();
+        // Each position's edges take its first edge's corners as their key, and are sorted
+        // by them: a pass over the merged edges then reads the scene's vertices, and the
+        // polygons on each edge, in order, not at random as the hashes fall.
+        let mut i = 0;
+        while i < keyed.len() {
+            let (a, b, _) = ends(&keyed[i]);
+            let n = keyed[i..].iter().take_while(|k| k.hash == keyed[i].hash && key(k) == key(&keyed[i])).count();
+            keyed[i..i + n].iter_mut().for_each(|k| k.hash = u64::from(a) << 32 | u64::from(b));
+            i += n;
+        }
+        keyed.par_sort_unstable_by_key(|k| (k.hash, k.corner));
+        let distinct = 1 + keyed.par_windows(2).filter(|w| w[0].hash != w[1].hash).count();
         self.edges.reserve_exact(distinct);
         self.sharing.reserve_exact(keyed.len());
         for (i, k) in keyed.iter().enumerate() {
-            let (a, b, forward) = ends(k);
-            if i == 0 || !same(&keyed[i - 1], k) {
+            let (_, _, forward) = ends(k);
+            if i == 0 || keyed[i - 1].hash != k.hash {
+                let (a, b) = ((k.hash >> 32) as u32, k.hash as u32);
                 let first = self.sharing.len() as u32;
                 self.edges.push(MergedEdge { a, b, first, count: 0 });
             }
@@ -730,9 +742,6 @@ impl Adjacency {
                 e.count += 1;
             }
         }
-        // In the order of their first corners, so that a pass over the edges reads the
-        // scene's vertices in order, not at random as the hashes fall.
-        self.edges.par_sort_unstable_by_key(|e| (e.a, e.b));
     }
 }
 
