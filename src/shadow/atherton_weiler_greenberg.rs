@@ -1349,7 +1349,12 @@ impl<'a> AthertonWeilerGreenberg<'a> {
                 overlay.add_wholes(&wholes);
                 counters.add(crate::stats::Counter::DetailPolygonsInView, overlay.len() as u64);
                 detail.push(overlay);
+                crate::pieces::let_go(screen);
             }
+        }
+        // A database built for this frame alone is let go by all threads.
+        if let Ok(databases) = Arc::try_unwrap(databases) {
+            databases.into_iter().flat_map(|db| db.samples).for_each(crate::pieces::let_go);
         }
         Ok(AthertonWeilerGreenberg { ctx, detail })
     }
