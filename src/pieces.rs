@@ -50,6 +50,12 @@ pub(crate) fn joined<S: Sync, T: Copy + Send + Sync>(parts: &[&[S]], f: impl Fn(
     list
 }
 
+/// Lets go of `list` by all threads: a list of many small allocations (a shadow database's
+/// million outlines) takes a thread tens of milliseconds to free, while the others wait.
+pub(crate) fn let_go<T: Send>(list: Vec<T>) {
+    list.into_par_iter().with_min_len(1024).for_each(drop);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -75,10 +81,4 @@ mod tests {
         assert_eq!(joined(&parts, |k, &x| 10 * k as u32 + x), [11, 12, 33, 34, 35]);
         assert!(joined::<u32, u32>(&[&[], &[]], |_, &x| x).is_empty());
     }
-}
-
-/// Lets go of `list` by all threads: a list of many small allocations (a shadow database's
-/// million outlines) takes a thread tens of milliseconds to free, while the others wait.
-pub(crate) fn let_go<T: Send>(list: Vec<T>) {
-    list.into_par_iter().with_min_len(1024).for_each(drop);
 }
