@@ -15,7 +15,8 @@ use rayon::prelude::*;
 /// `list` cut, from its start, into consecutive stretches of the given lengths (which sum
 /// to at most its length).
 pub(crate) fn stretches<T>(mut list: &mut [T], lengths: impl IntoIterator<Item = usize>) -> Vec<&mut [T]> {
-    let mut out = Vec::new();
+    let lengths = lengths.into_iter();
+    let mut out = Vec::with_capacity(lengths.size_hint().0);
     for n in lengths {
         let (stretch, rest) = std::mem::take(&mut list).split_at_mut(n);
         out.push(stretch);

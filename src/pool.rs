@@ -4,6 +4,7 @@
 //! already has instead of having the system hand out and zero fresh ones (which, for a
 //! 1920x1080 frame, costs more than drawing a simple scene).
 
+use rayon::prelude::*;
 use std::any::Any;
 use std::sync::{Arc, Mutex};
 
@@ -47,14 +48,15 @@ impl<B> Kept<B> {
 pub(crate) type Pool<T> = Kept<Vec<T>>;
 
 impl<T> Kept<Vec<T>> {
-    /// A buffer of `len` copies of `value`, in kept memory where there is some.
+    /// A buffer of `len` copies of `value`, in kept memory where there is some, written by
+    /// all threads (a frame's buffer is millions of entries).
     pub(crate) fn filled(&self, len: usize, value: T) -> Vec<T>
     where
-        T: Clone,
+        T: Clone + Send,
     {
         let mut v = self.take();
         v.clear();
-        v.resize(len, value);
+        v.par_extend(rayon::iter::repeat_n(value, len));
         v
     }
 

@@ -509,17 +509,10 @@ impl SphereGrid {
             },
         );
         keys.par_sort_unstable();
-        let mut first = vec![0u32; g * g + 1];
-        let mut cell = 0;
-        for (j, &key) in keys.iter().enumerate() {
-            while cell <= (key >> 32) as usize {
-                first[cell] = j as u32;
-                cell += 1;
-            }
-        }
-        first[cell..].fill(keys.len() as u32);
+        // Where each cell's keys start, found by bisection, each cell on its own.
+        grid.first =
+            (0..=g * g).into_par_iter().map(|k| keys.partition_point(|&key| key >> 32 < k as u64) as u32).collect();
         grid.binned = keys.par_iter().map(|&key| key as u32).collect();
-        grid.first = first;
         grid
     }
 

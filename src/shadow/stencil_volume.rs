@@ -35,14 +35,15 @@ impl<'a> StencilVolume<'a> {
         let bytes = crate::budget::mul(samples, pixels).saturating_add(8 * pixels);
         crate::budget::check(format_args!("stencil-volume: {samples} lit mask(s) of {w}x{h}"), bytes)?;
         let scene = ctx.scene;
-        // The depth buffer of the visible surfaces, from the visibility stage's runs.
+        // The depth buffer of the visible surfaces, from the visibility stage's runs, a line
+        // each (ours: by all threads, as every per-frame list below).
         let mut surface = ctx.pools.u32.filled(w * h as usize, u32::MAX);
-        for (y, runs) in ctx.runs.lines.iter().enumerate() {
+        surface.par_chunks_mut(w).zip(&ctx.runs.lines).for_each(|(line, runs)| {
             for r in runs {
-                surface[y * w + r.x0 as usize..y * w + r.x1 as usize].fill(r.poly);
+                line[r.x0 as usize..r.x1 as usize].fill(r.poly);
             }
-        }
-        let planes: Vec<Option<DepthPlane>> = scene.polygons.iter().map(|p| view.depth_plane(&p.plane)).collect();
+        });
+        let planes: Vec<Option<DepthPlane>> = scene.polygons.par_iter().map(|p| view.depth_plane(&p.plane)).collect();
         let adjacency = Adjacency::kept(scene, options.construction != Construction::PerPolygon, &ctx.pools.stash);
         let counting = options.counting;
         let band = crate::scan::band_height(h);
@@ -81,7 +82,7 @@ impl<'a> StencilVolume<'a> {
                 writes += written;
                 let mut lit = ctx.pools.masks.take();
                 lit.clear();
-                lit.extend(stencil.iter().map(|&c| c <= 0));
+                lit.par_extend(stencil.par_iter().map(|&c| c <= 0));
                 ctx.pools.i32.give(stencil);
                 lit
             })
