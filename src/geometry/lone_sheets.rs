@@ -17,10 +17,11 @@
 //! rings whose even-odd inside is exactly that union.
 
 use super::weiler_atherton::signed_area;
-use super::{edge_loops, grid_cells, simple};
+use super::{edge_loops, grid_cells, grid_rectangle, simple};
 use glam::DVec2;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// No item (an edge with nothing across it).
 pub(crate) const NO_ITEM: u32 = u32::MAX;
@@ -210,30 +211,39 @@ impl Grid {
     /// Every item's box marked with `owner(i)`, on square cells as wide as the median box
     /// (fewer where that would make more than [`CELLS_PER_ITEM`] per item); `None` when that
     /// would mark more than [`MARKS_PER_ITEM`] cells per item.
-    fn new(items: &[Item], owner: impl Fn(usize) -> u32) -> Option<Grid> {
-        let (lo, hi) = items.iter().map(|i| i.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))?;
+    fn new(items: &[Item], owner: impl Fn(usize) -> u32 + Sync) -> Option<Grid> {
+        let (lo, hi) = items.par_iter().map(|i| i.bounds).reduce_with(|a, b| (a.0.min(b.0), a.1.max(b.1)))?;
         let size = (hi - lo).max(DVec2::splat(1e-300));
-        let mut widths: Vec<f64> = items.iter().map(|i| (i.bounds.1 - i.bounds.0).max_element()).collect();
+        let mut widths: Vec<f64> = items.par_iter().map(|i| (i.bounds.1 - i.bounds.0).max_element()).collect();
         let k = widths.len() / 2;
         let median = *widths.select_nth_unstable_by(k, f64::total_cmp).1;
         let most = (CELLS_PER_ITEM * items.len()).max(1) as f64;
         let cell = median.max((size.x * size.y / most).sqrt()).max(1e-300);
         let count = |w: f64| ((w / cell).ceil() as usize).clamp(1, 4096);
         let g = (count(size.x), count(size.y));
-        let mut grid = Grid { cells: vec![EMPTY; g.0 * g.1], lo, size, g };
-        let mut marks = 0;
-        for (i, item) in items.iter().enumerate() {
+        let marks: usize = items
+            .par_iter()
+            .map(|item| {
+                let (c0, c1, r0, r1) = grid_rectangle(lo, size, g, item.bounds);
+                (c1 + 1 - c0) * (r1 + 1 - r0)
+            })
+            .sum();
+        if marks > MARKS_PER_ITEM * items.len() + 1024 {
+            return None;
+        }
+        // Marked by all threads: a cell's mark is the same whatever order its owners come in
+        // (one owner, or CONFLICT), so each is merged into its cell atomically.
+        let cells: Vec<AtomicU32> = (0..g.0 * g.1).into_par_iter().map(|_| AtomicU32::new(EMPTY)).collect();
+        items.par_iter().enumerate().for_each(|(i, item)| {
             let o = owner(i);
             for (c, r) in grid_cells(lo, size, g, item.bounds) {
-                marks += 1;
-                if marks > MARKS_PER_ITEM * items.len() + 1024 {
-                    return None;
-                }
-                let cell = &mut grid.cells[c * g.1 + r];
-                *cell = if *cell == EMPTY || *cell == o { o } else { CONFLICT };
+                let merge =
+                    |cell: u32| (cell != o && cell != CONFLICT).then_some(if cell == EMPTY { o } else { CONFLICT });
+                let _ = cells[c * g.1 + r].fetch_update(Ordering::Relaxed, Ordering::Relaxed, merge);
             }
-        }
-        Some(grid)
+        });
+        let cells = cells.into_par_iter().map(AtomicU32::into_inner).collect();
+        Some(Grid { cells, lo, size, g })
     }
 
     /// Whether every cell `bounds` meets is held by `owner` alone.

@@ -878,18 +878,24 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
         if backgrounds && m.polys.iter().all(|p| p.casts) { wide_backgrounds(scene, m) } else { vec![false; n] };
     let kept: Vec<usize> = (0..n).into_par_iter().filter(|&i| !behind[i]).collect();
     // The items across each whole caster's edges, by their places among the kept (a whole
-    // polygon is mapped once a view): worked out in parallel, in order.
+    // polygon is mapped once a view, and the mapped polygons are in the order of their
+    // sources: a source's place is found by bisection): worked out in parallel, in order.
     let sheet = |p: &MappedPolygon| p.casts && p.whole;
-    let mut local = vec![NO_ITEM; scene.polygons.len()];
-    for (k, &i) in kept.iter().enumerate().filter(|(_, &i)| sheet(&m.polys[i])) {
-        local[m.polys[i].source as usize] = k as u32;
-    }
+    let sources: Vec<u32> = kept.par_iter().map(|&i| m.polys[i].source).collect();
+    debug_assert!(sources.windows(2).all(|w| w[0] < w[1]));
+    let local = |q: u32| {
+        let k = sources.partition_point(|&s| s < q);
+        match sources.get(k) {
+            Some(&s) if s == q && sheet(&m.polys[kept[k]]) => k as u32,
+            _ => NO_ITEM,
+        }
+    };
     let across: Vec<u32> = kept
         .par_iter()
         .map(|&i| &m.polys[i])
         .filter(|p| sheet(p))
         .flat_map_iter(|p| scene.across(p.source as usize).iter())
-        .map(|&q| local.get(q as usize).copied().unwrap_or(NO_ITEM))
+        .map(|&q| local(q))
         .collect();
     let edges_of = |&i: &usize| if sheet(&m.polys[i]) { m.polys[i].len as usize } else { 0 };
     let first = pieces::starts(kept.iter().map(edges_of));
@@ -915,13 +921,11 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
             Piece::new(p.source, Region { rings }, p.near)
         })
         .collect();
-    let mut sorted: Vec<bool> = behind.iter().map(|&b| !b).collect();
-    let mut lone = Vec::new();
-    for (&i, _) in kept.iter().zip(&found.lone).filter(|(_, &l)| l) {
-        sorted[i] = false;
-        lone.push(m.polys[i].source);
-    }
-    let behind = (0..n).filter(|&i| behind[i]).filter_map(|i| m.piece(&m.polys[i])).collect();
+    // By all threads: a kept polygon's place among the kept is found by bisection.
+    let sorted: Vec<bool> =
+        (0..n).into_par_iter().map(|i| !behind[i] && !found.lone[kept.partition_point(|&j| j < i)]).collect();
+    let lone = kept.par_iter().zip(&found.lone).filter(|(_, &l)| l).map(|(&i, _)| m.polys[i].source).collect();
+    let behind = (0..n).into_par_iter().filter(|&i| behind[i]).filter_map(|i| m.piece(&m.polys[i])).collect();
     LoneSplit { lone, outlines, behind, sorted }
 }
 
