@@ -97,14 +97,27 @@ fn sheets(items: &[Item]) -> Vec<u32> {
         }
         i
     }
-    for (i, item) in items.iter().enumerate() {
-        let Some((_, across)) = item.sheet else { continue };
-        for &j in across.iter().filter(|&&j| j != NO_ITEM && (j as usize) < items.len()) {
-            if signs[i] != 0.0 && signs[i] == signs[j as usize] && runs_back(items, i as u32, j) {
-                let (a, b) = (up(&mut parent, i as u32), up(&mut parent, j));
-                parent[a.max(b) as usize] = a.min(b);
-            }
-        }
+    // The pairs that join, tested by all threads; then joined on one (each set's root is
+    // its least member, whatever the order of the joins).
+    let signs_of = &signs;
+    let joins: Vec<(u32, u32)> = items
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(i, item)| {
+            let across = item.sheet.map_or(&[][..], |(_, across)| across);
+            let joins = move |&&j: &&u32| {
+                j != NO_ITEM
+                    && (j as usize) < items.len()
+                    && signs_of[i] != 0.0
+                    && signs_of[i] == signs_of[j as usize]
+                    && runs_back(items, i as u32, j)
+            };
+            across.iter().filter(joins).map(move |&j| (i as u32, j))
+        })
+        .collect();
+    for (i, j) in joins {
+        let (a, b) = (up(&mut parent, i), up(&mut parent, j));
+        parent[a.max(b) as usize] = a.min(b);
     }
     (0..items.len() as u32).map(|i| if signs[i as usize] == 0.0 { NO_ITEM } else { up(&mut parent, i) }).collect()
 }
