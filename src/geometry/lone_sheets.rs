@@ -82,7 +82,7 @@ pub(crate) fn find(items: &[Item]) -> Lone {
 
 /// Each item's sheet (the least item of it), or [`NO_ITEM`] for items that are in none: the
 /// items joined across their shared edges where both are wound the same way.
-fn sheets(items: &[Item]) -> Vec<u32> {
+fn sheets<'a>(items: &[Item<'a>]) -> Vec<u32> {
     let sign = |i: usize| {
         let a = items[i].sheet.map_or(0.0, |(ring, _)| signed_area(ring));
         f64::from(a > 0.0) - f64::from(a < 0.0)
@@ -97,27 +97,32 @@ fn sheets(items: &[Item]) -> Vec<u32> {
         }
         i
     }
-    // The pairs that join, tested by all threads; then joined on one (each set's root is
-    // its least member, whatever the order of the joins).
+    // Whether each edge's pair joins, tested by all threads (a flag an edge, in the order of
+    // the items and their edges); then joined on one (each set's root is its least member,
+    // whatever the order of the joins).
+    let across_of = |item: &Item<'a>| item.sheet.map_or(&[][..], |(_, across)| across);
     let signs_of = &signs;
-    let joins: Vec<(u32, u32)> = items
+    let joins: Vec<bool> = items
         .par_iter()
         .enumerate()
         .flat_map_iter(|(i, item)| {
-            let across = item.sheet.map_or(&[][..], |(_, across)| across);
-            let joins = move |&&j: &&u32| {
+            across_of(item).iter().map(move |&j| {
                 j != NO_ITEM
                     && (j as usize) < items.len()
                     && signs_of[i] != 0.0
                     && signs_of[i] == signs_of[j as usize]
                     && runs_back(items, i as u32, j)
-            };
-            across.iter().filter(joins).map(move |&j| (i as u32, j))
+            })
         })
         .collect();
-    for (i, j) in joins {
-        let (a, b) = (up(&mut parent, i), up(&mut parent, j));
-        parent[a.max(b) as usize] = a.min(b);
+    let mut joins = joins.into_iter();
+    for (i, item) in items.iter().enumerate() {
+        for (&j, join) in across_of(item).iter().zip(joins.by_ref()) {
+            if join {
+                let (a, b) = (up(&mut parent, i as u32), up(&mut parent, j));
+                parent[a.max(b) as usize] = a.min(b);
+            }
+        }
     }
     (0..items.len() as u32).map(|i| if signs[i as usize] == 0.0 { NO_ITEM } else { up(&mut parent, i) }).collect()
 }
