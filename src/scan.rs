@@ -285,6 +285,17 @@ impl EdgeTable {
         self.built = false;
     }
 
+    /// A table of the `parts`' edges one after another (none of them sorted yet), part
+    /// `k`'s tags raised by `tags[k]`: the table adding their rings in turn would build,
+    /// joined by all threads.
+    pub(crate) fn joined(height: u32, parts: &[&EdgeTable], tags: &[u32]) -> EdgeTable {
+        let edges: Vec<&[Edge]> = parts.iter().map(|t| &t.edges[..]).collect();
+        let mut table = EdgeTable::one_frame(height);
+        table.edges = crate::pieces::joined(&edges, |k, &e| Edge { tag: e.tag + tags[k], ..e });
+        table.edges.par_iter_mut().enumerate().for_each(|(k, e)| e.seq = k as u32);
+        table
+    }
+
     /// Sorts the edges into buckets by first line (a counting sort, stable: a line's edges
     /// keep the order they were added in). Call it after the last `add_ring` and before
     /// walking the table.
@@ -910,6 +921,44 @@ mod tests {
                 proptest::prop_assert_eq!(walked, table);
             }
         }
+    }
+
+    /// Tables of consecutive pieces of the rings, each numbering its own from 0, joined
+    /// with their tags raised make the table that adding every ring in turn makes: the
+    /// same edges, tags and order once sorted (where a tag were not raised, or a piece's
+    /// order lost, the lists would differ).
+    #[test]
+    fn tables_of_pieces_joined_make_the_table_of_the_whole() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let rings: Vec<Vec<DVec2>> = (0..700)
+            .map(|_| {
+                let at = DVec2::new(rng.gen_range(0.0..80.0), rng.gen_range(0.0..50.0));
+                (0..3).map(|_| at + DVec2::new(rng.gen_range(0.0..9.0), rng.gen_range(0.0..9.0))).collect()
+            })
+            .collect();
+        let listed = |t: &EdgeTable| t.edges().map(|e| (e.0, e.1, e.2, e.3.to_bits())).collect::<Vec<_>>();
+        let mut whole = EdgeTable::one_frame(60);
+        for (tag, ring) in rings.iter().enumerate() {
+            whole.add_ring(tag as u32, ring);
+        }
+        whole.finish();
+        let pieces: Vec<EdgeTable> = rings
+            .chunks(256)
+            .map(|piece| {
+                let mut t = EdgeTable::one_frame(60);
+                piece.iter().enumerate().for_each(|(tag, ring)| t.add_ring(tag as u32, ring));
+                t
+            })
+            .collect();
+        let parts: Vec<&EdgeTable> = pieces.iter().collect();
+        let mut joined = EdgeTable::joined(60, &parts, &[0, 256, 512]);
+        joined.finish();
+        assert!(whole.len() > 1500, "{}", whole.len());
+        assert_eq!(listed(&joined), listed(&whole));
+        let mut unraised = EdgeTable::joined(60, &parts, &[0, 0, 0]);
+        unraised.finish();
+        assert_ne!(listed(&unraised), listed(&whole));
     }
 
     /// The parallel `add_rings` builds the table `add_ring` builds ring by ring: the same

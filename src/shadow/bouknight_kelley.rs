@@ -186,8 +186,57 @@ fn shadow_polygons(
 /// projected from the light onto `b`'s plane and into the image, unless (ours, with their
 /// switches) it lies wholly behind `b` as the light sees it or outside `b`'s wedge. Returns
 /// the tally, the shadow polygons' edge table, and (for traces) what became of each pair.
+///
+/// A receiver under more than [`CASTERS_PER_PIECE`] candidates (s3's floor has a million)
+/// is worked on by all threads (ours), its candidates cut into pieces in order whose tables
+/// and pairs are joined in order: the table one thread would build, and no thread left to
+/// project a million casters alone.
 #[allow(clippy::too_many_arguments)]
 fn project_onto(
+    ctx: &ShadowContext,
+    options: BouknightKelleyOptions,
+    sample: LightSample,
+    b: u32,
+    candidates: &[u32],
+    proj: &mut Projector,
+    scratch: &mut [Vec<DVec3>; 2],
+    ring: &mut Vec<DVec2>,
+) -> (Tally, ReceiverTable, Pairs) {
+    let parts: Vec<(Tally, ReceiverTable, Pairs)> = if candidates.len() > CASTERS_PER_PIECE {
+        candidates
+            .par_chunks(CASTERS_PER_PIECE)
+            .map_init(
+                || (Projector::default(), [Vec::new(), Vec::new()], Vec::new()),
+                |(proj, scratch, ring), piece| project_piece(ctx, options, sample, b, piece, proj, scratch, ring),
+            )
+            .collect()
+    } else {
+        vec![project_piece(ctx, options, sample, b, candidates, proj, scratch, ring)]
+    };
+    let mut tally = Tally::default();
+    let mut pairs = Pairs::default();
+    let mut tables = Vec::with_capacity(parts.len());
+    for (t, table, p) in parts {
+        tally.add(&t);
+        pairs.kept.extend(p.kept);
+        pairs.behind.extend(p.behind);
+        pairs.shadow_polygons.extend(p.shadow_polygons);
+        tables.push(table);
+    }
+    let table = if tables.len() == 1 { tables.pop() } else { ReceiverTable::joined(tables, ctx.view.height) };
+    let mut table = table.unwrap_or_else(|| ReceiverTable::new(b, ctx.view.height, ctx.keep_outlines));
+    table.finish();
+    (tally, table, pairs)
+}
+
+/// The most candidate casters of one receiver that one thread projects (see
+/// [`project_onto`]).
+const CASTERS_PER_PIECE: usize = 8192;
+
+/// Steps 2 and 3 for receiver `b` and the candidates `candidates` (all of them, or a piece),
+/// into an unfinished table.
+#[allow(clippy::too_many_arguments)]
+fn project_piece(
     ctx: &ShadowContext,
     options: BouknightKelleyOptions,
     sample: LightSample,
@@ -231,7 +280,6 @@ fn project_onto(
             }
         }
     }
-    table.finish();
     (tally, table, pairs)
 }
 

@@ -92,6 +92,20 @@ impl ReceiverTable {
         }
     }
 
+    /// The polygons of `parts` (tables of one receiver, none finished), one part after
+    /// another: the table adding them in turn would build.
+    pub(crate) fn joined(parts: Vec<ReceiverTable>, height: u32) -> Option<Self> {
+        let first = parts.first()?;
+        let (receiver, keep_rings) = (first.receiver, first.keep_rings);
+        let tags = crate::pieces::starts(parts.iter().map(|p| p.count as usize));
+        let tags: Vec<u32> = tags.into_iter().map(|t| t as u32).collect();
+        let tables: Vec<&EdgeTable> = parts.iter().map(|p| &p.table).collect();
+        let table = EdgeTable::joined(height, &tables, &tags);
+        let count = parts.iter().map(|p| p.count).sum();
+        let rings = parts.into_iter().flat_map(|p| p.rings).collect();
+        Some(ReceiverTable { receiver, table, count, rings, keep_rings })
+    }
+
     /// The receiver.
     pub fn receiver(&self) -> u32 {
         self.receiver
