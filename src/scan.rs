@@ -285,15 +285,24 @@ impl EdgeTable {
         self.built = false;
     }
 
-    /// A table of the `parts`' edges one after another (none of them sorted yet), part
-    /// `k`'s tags raised by `tags[k]`: the table adding their rings in turn would build,
-    /// joined by all threads.
-    pub(crate) fn joined(height: u32, parts: &[&EdgeTable], tags: &[u32]) -> EdgeTable {
-        let edges: Vec<&[Edge]> = parts.iter().map(|t| &t.edges[..]).collect();
-        let mut table = EdgeTable::one_frame(height);
-        table.edges = crate::pieces::joined(&edges, |k, &e| Edge { tag: e.tag + tags[k], ..e });
-        table.edges.par_iter_mut().enumerate().for_each(|(k, e)| e.seq = k as u32);
-        table
+    /// Makes room for `more` edges, exactly.
+    pub(crate) fn reserve_exact(&mut self, more: usize) {
+        self.edges.reserve_exact(more);
+    }
+
+    /// Adds `other`'s edges (neither table sorted yet) after this table's, their tags raised
+    /// by `tag`: the table adding `other`'s rings here in turn would build. `other` is let go
+    /// as soon as it is read, so that the two exist at once for no longer than the copy.
+    pub(crate) fn append(&mut self, other: EdgeTable, tag: u32) {
+        let start = self.edges.len();
+        self.edges.extend(other.edges.iter().map(|&e| Edge { tag: e.tag + tag, ..e }));
+        drop(other);
+        if self.in_place {
+            for (seq, e) in (start as u32..).zip(&mut self.edges[start..]) {
+                e.seq = seq;
+            }
+        }
+        self.built = false;
     }
 
     /// Sorts the edges into buckets by first line (a counting sort, stable: a line's edges
@@ -923,7 +932,7 @@ mod tests {
         }
     }
 
-    /// Tables of consecutive pieces of the rings, each numbering its own from 0, joined
+    /// Tables of consecutive pieces of the rings, each numbering its own from 0, appended
     /// with their tags raised make the table that adding every ring in turn makes: the
     /// same edges, tags and order once sorted (where a tag were not raised, or a piece's
     /// order lost, the lists would differ).
@@ -951,13 +960,18 @@ mod tests {
                 t
             })
             .collect();
-        let parts: Vec<&EdgeTable> = pieces.iter().collect();
-        let mut joined = EdgeTable::joined(60, &parts, &[0, 256, 512]);
-        joined.finish();
+        let join = |tags: [u32; 3]| {
+            let mut parts = pieces.clone().into_iter();
+            let mut joined = parts.next().unwrap_or_default();
+            for (part, tag) in parts.zip(&tags[1..]) {
+                joined.append(part, *tag);
+            }
+            joined.finish();
+            joined
+        };
         assert!(whole.len() > 1500, "{}", whole.len());
-        assert_eq!(listed(&joined), listed(&whole));
-        let mut unraised = EdgeTable::joined(60, &parts, &[0, 0, 0]);
-        unraised.finish();
+        assert_eq!(listed(&join([0, 256, 512])), listed(&whole));
+        let unraised = join([0, 0, 0]);
         assert_ne!(listed(&unraised), listed(&whole));
     }
 

@@ -189,7 +189,7 @@ fn shadow_polygons(
 ///
 /// A receiver under more than [`CASTERS_PER_PIECE`] candidates (s3's floor has a million)
 /// is worked on by all threads (ours), its candidates cut into pieces in order whose tables
-/// and pairs are joined in order: the table one thread would build, and no thread left to
+/// and pairs are appended in order: the table one thread would build, and no thread left to
 /// project a million casters alone.
 #[allow(clippy::too_many_arguments)]
 fn project_onto(
@@ -216,14 +216,14 @@ fn project_onto(
     let mut tally = Tally::default();
     let mut pairs = Pairs::default();
     let mut tables = Vec::with_capacity(parts.len());
-    for (t, table, p) in parts {
+    for (t, part, p) in parts {
         tally.add(&t);
         pairs.kept.extend(p.kept);
         pairs.behind.extend(p.behind);
         pairs.shadow_polygons.extend(p.shadow_polygons);
-        tables.push(table);
+        tables.push(part);
     }
-    let table = if tables.len() == 1 { tables.pop() } else { ReceiverTable::joined(tables, ctx.view.height) };
+    let table = ReceiverTable::joined(tables);
     let mut table = table.unwrap_or_else(|| ReceiverTable::new(b, ctx.view.height, ctx.keep_outlines));
     table.finish();
     (tally, table, pairs)

@@ -93,17 +93,19 @@ impl ReceiverTable {
     }
 
     /// The polygons of `parts` (tables of one receiver, none finished), one part after
-    /// another: the table adding them in turn would build.
-    pub(crate) fn joined(parts: Vec<ReceiverTable>, height: u32) -> Option<Self> {
-        let first = parts.first()?;
-        let (receiver, keep_rings) = (first.receiver, first.keep_rings);
-        let tags = crate::pieces::starts(parts.iter().map(|p| p.count as usize));
-        let tags: Vec<u32> = tags.into_iter().map(|t| t as u32).collect();
-        let tables: Vec<&EdgeTable> = parts.iter().map(|p| &p.table).collect();
-        let table = EdgeTable::joined(height, &tables, &tags);
-        let count = parts.iter().map(|p| p.count).sum();
-        let rings = parts.into_iter().flat_map(|p| p.rings).collect();
-        Some(ReceiverTable { receiver, table, count, rings, keep_rings })
+    /// another: the table adding them in turn would build. Each part is let go once it is
+    /// copied, into room made once.
+    pub(crate) fn joined(parts: Vec<ReceiverTable>) -> Option<Self> {
+        let more: usize = parts.iter().skip(1).map(|p| p.table.len()).sum();
+        let mut parts = parts.into_iter();
+        let mut joined = parts.next()?;
+        joined.table.reserve_exact(more);
+        for ReceiverTable { table, count, mut rings, .. } in parts {
+            joined.table.append(table, joined.count);
+            joined.count += count;
+            joined.rings.append(&mut rings);
+        }
+        Some(joined)
     }
 
     /// The receiver.
