@@ -169,6 +169,8 @@ pub struct Measured {
     pub phases: BTreeMap<String, Spread>,
     /// The last timed run's frame and statistics.
     pub last: Rendered,
+    /// The most heap the first frame had allocated at once, where the heap was counted.
+    pub peak_bytes: Option<u64>,
 }
 
 /// The measuring core of `bench`, `compare` and `scale`: `warmup` untimed renders, then
@@ -189,6 +191,7 @@ struct Timing {
     renderer: Renderer,
     times_ms: Vec<f64>,
     phases: BTreeMap<String, Vec<f64>>,
+    peak_bytes: Option<u64>,
 }
 
 impl Timing {
@@ -209,7 +212,8 @@ impl Timing {
     fn finish(self) -> Result<Measured> {
         let last = self.renderer.into_rendered().ok_or_else(|| Error::Internal("no timed run".into()))?;
         let phases = self.phases.into_iter().map(|(k, v)| (k, Spread::of(v))).collect();
-        Ok(Measured { frame: Spread::of(self.times_ms.clone()), times_ms: self.times_ms, phases, last })
+        let (times_ms, peak_bytes) = (self.times_ms, self.peak_bytes);
+        Ok(Measured { frame: Spread::of(times_ms.clone()), times_ms, phases, last, peak_bytes })
     }
 }
 
@@ -230,16 +234,12 @@ pub fn bench(scene: &Scene, o: &BenchOptions, mut progress: impl FnMut(&str)) ->
                 back_face_cull: o.back_face_cull,
                 ..RenderOptions::default()
             };
-            let measured = measure_undisturbed(scene, &opts, o, &pools, &mut progress);
-            if let Some(h) = o.heap {
-                (h.count)(false);
-            }
-            let (each, disturbance) = measured?;
-            let peak_mb = o.heap.map(|h| (h.peak_bytes)() as f64 / (1024.0 * 1024.0));
+            let (each, disturbance) = measure_undisturbed(scene, &opts, o, &pools, &mut progress)?;
             let (first, first_min) = (each[0].times_ms.clone(), each[0].frame.min_ms);
             let (first_phases, first_frame) = (each[0].phases.clone(), each[0].frame.median_ms);
             let n1 = pools[0].current_num_threads();
             for (m, pool) in each.into_iter().zip(&pools) {
+                let peak_mb = m.peak_bytes.map(|b| b as f64 / (1024.0 * 1024.0));
                 let several = pools.len() > 1;
                 let speedup = several.then(|| paired_ratio(&first, &m.times_ms));
                 let speedup_best = several.then(|| times_faster(first_min, m.frame.min_ms));
@@ -336,16 +336,23 @@ fn measure_undisturbed(
         let mut timings: Vec<Timing> = pools.iter().map(|_| Timing::default()).collect();
         for i in 0..o.warmup + o.runs {
             let timed = i >= o.warmup;
-            // The first frame is counted (see `HeapProbe`), the rest are not.
-            if let Some(h) = o.heap.filter(|_| i <= 1) {
-                (h.count)(i == 0);
-            }
             // Where the count changes before each frame, an untimed frame first settles the
             // new count's threads, cores and caches, as a run of frames at one count would.
             let settle = usize::from(timed && pools.len() > 1);
             for (timing, pool) in timings.iter_mut().zip(pools) {
                 pool.install(|| (0..settle).try_for_each(|_| timing.frame(scene, opts, false)))?;
-                pool.install(|| timing.frame(scene, opts, timed))?;
+                // Each count's first frame is counted on its own (see `HeapProbe`), the rest
+                // are not: what the renderers of the other counts keep is not its own.
+                let counted = o.heap.filter(|_| i == 0);
+                if let Some(h) = counted {
+                    (h.count)(true);
+                }
+                let frame = pool.install(|| timing.frame(scene, opts, timed));
+                if let Some(h) = counted {
+                    timing.peak_bytes = Some((h.peak_bytes)());
+                    (h.count)(false);
+                }
+                frame?;
             }
         }
         let foreign = monitor.foreign_if_long();
