@@ -1284,7 +1284,7 @@ impl<'a> AthertonWeilerGreenberg<'a> {
         options: AthertonWeilerGreenbergOptions,
         counters: &mut Counters,
     ) -> Result<Self> {
-        let databases: Arc<Vec<ShadowDatabase>> = match &ctx.awg_database {
+        let mut databases: Arc<Vec<ShadowDatabase>> = match &ctx.awg_database {
             Some(db) if db.len() == ctx.scene.lights.len() => db.clone(),
             Some(_) => {
                 return Err(Error::InvalidOption("the shadow database does not match the scene's lights".into()))
@@ -1310,57 +1310,57 @@ impl<'a> AthertonWeilerGreenberg<'a> {
         };
         let view = ctx.view;
         let mut detail = Vec::new();
-        let mut databases = databases;
-        let samples: Vec<(usize, usize)> =
-            databases.iter().enumerate().flat_map(|(l, db)| (0..db.samples.len()).map(move |s| (l, s))).collect();
-        for (l, s) in samples {
-            let polys = &databases[l].samples[s];
-            // Through the camera in parallel, into the overlay in order.
-            // A detail polygon that is its whole source polygon (ours) covers every run
-            // on it: it needs no edges (but is drawn with them for `--debug`).
-            let whole: Vec<bool> = polys
-                .par_iter()
-                .map(|d| {
-                    !ctx.keep_outlines && matches!(&d.rings[..], [r] if r[..] == *ctx.scene.verts(d.source as usize))
-                })
-                .collect();
-            let seen =
-                |(d, &whole): &(&DetailPolygon, &bool), want: bool| whole == want && ctx.visible[d.source as usize];
-            let wholes: Vec<u32> =
-                polys.par_iter().zip(&whole).filter(|p| seen(p, true)).map(|(d, _)| d.source).collect();
-            let screen: Vec<(u32, Vec<Vec<DVec2>>)> = polys
-                .par_iter()
-                .zip(&whole)
-                .filter(|p| seen(p, false))
-                .map(|(d, _)| d)
-                .map_init(
-                    || ([Vec::new(), Vec::new()], Vec::new()),
-                    |(scratch, ring), d| {
-                        let mut rings = Vec::new();
-                        for r in &d.rings {
-                            if view.clip_project(r, scratch, ring) {
-                                rings.push(ring.clone());
+        for l in 0..databases.len() {
+            for s in 0..databases[l].samples.len() {
+                let polys = &databases[l].samples[s];
+                // Through the camera in parallel, into the overlay in order.
+                // A detail polygon that is its whole source polygon (ours) covers every run
+                // on it: it needs no edges (but is drawn with them for `--debug`).
+                let whole: Vec<bool> = polys
+                    .par_iter()
+                    .map(|d| {
+                        !ctx.keep_outlines
+                            && matches!(&d.rings[..], [r] if r[..] == *ctx.scene.verts(d.source as usize))
+                    })
+                    .collect();
+                let seen =
+                    |(d, &whole): &(&DetailPolygon, &bool), want: bool| whole == want && ctx.visible[d.source as usize];
+                let wholes: Vec<u32> =
+                    polys.par_iter().zip(&whole).filter(|p| seen(p, true)).map(|(d, _)| d.source).collect();
+                let screen: Vec<(u32, Vec<Vec<DVec2>>)> = polys
+                    .par_iter()
+                    .zip(&whole)
+                    .filter(|p| seen(p, false))
+                    .map(|(d, _)| d)
+                    .map_init(
+                        || ([Vec::new(), Vec::new()], Vec::new()),
+                        |(scratch, ring), d| {
+                            let mut rings = Vec::new();
+                            for r in &d.rings {
+                                if view.clip_project(r, scratch, ring) {
+                                    rings.push(ring.clone());
+                                }
                             }
-                        }
-                        (d.source, rings)
-                    },
-                )
-                .collect();
-            // A database built for this frame alone lets each sample's detail polygons go
-            // once they are through the camera, before its overlay is made.
-            if let Some(databases) = Arc::get_mut(&mut databases) {
-                crate::pieces::let_go(std::mem::take(&mut databases[l].samples[s]));
+                            (d.source, rings)
+                        },
+                    )
+                    .collect();
+                // A database built for this frame alone lets each sample's detail polygons go
+                // once they are through the camera, before its overlay is made.
+                if let Some(databases) = Arc::get_mut(&mut databases) {
+                    crate::pieces::let_go(std::mem::take(&mut databases[l].samples[s]));
+                }
+                // Grouped by source polygon, in the order sources first come, by all threads
+                // (a hash map filled on one thread was a serial tenth of s3's preparation);
+                // each source's edge table is built on its own, in parallel.
+                let receivers = grouped_by_source(&screen);
+                let rings_of = |&i: &u32| screen[i as usize].1.as_slice();
+                let mut overlay = Overlay::from_receivers(view.height, ctx.keep_outlines, &receivers, rings_of);
+                overlay.add_wholes(&wholes);
+                counters.add(crate::stats::Counter::DetailPolygonsInView, overlay.len() as u64);
+                detail.push(overlay);
+                crate::pieces::let_go(screen);
             }
-            // Grouped by source polygon, in the order sources first come, by all threads
-            // (a hash map filled on one thread was a serial tenth of s3's preparation);
-            // each source's edge table is built on its own, in parallel.
-            let receivers = grouped_by_source(&screen);
-            let rings_of = |&i: &u32| screen[i as usize].1.as_slice();
-            let mut overlay = Overlay::from_receivers(view.height, ctx.keep_outlines, &receivers, rings_of);
-            overlay.add_wholes(&wholes);
-            counters.add(crate::stats::Counter::DetailPolygonsInView, overlay.len() as u64);
-            detail.push(overlay);
-            crate::pieces::let_go(screen);
         }
         Ok(AthertonWeilerGreenberg { ctx, detail })
     }

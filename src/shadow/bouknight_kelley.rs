@@ -72,6 +72,15 @@ pub struct Pairs {
     pub shadow_polygons: Vec<(u32, u32)>,
 }
 
+impl Pairs {
+    /// Adds what became of the pairs of `other`, a later piece of the same receiver's.
+    fn append(&mut self, mut other: Pairs) {
+        self.kept.append(&mut other.kept);
+        self.behind.append(&mut other.behind);
+        self.shadow_polygons.append(&mut other.shadow_polygons);
+    }
+}
+
 impl<'a> BouknightKelley<'a> {
     /// Makes the shadow polygons of every light sample.
     pub fn new(ctx: &'a ShadowContext<'a>, options: BouknightKelleyOptions, counters: &mut Counters) -> Self {
@@ -135,9 +144,9 @@ fn shadow_polygons(
                     stamp.clear();
                     stamp.resize(n, u32::MAX);
                 }
-                (Projector::default(), stamp, [Vec::new(), Vec::new()], Vec::new(), Vec::new())
+                (Workspace::default(), stamp, Vec::new())
             },
-            |(proj, stamp, scratch, ring, candidates), &b| {
+            |(work, stamp, candidates), &b| {
                 let t = Instant::now();
                 let mut tested = 0;
                 match (&grid, &extents) {
@@ -147,7 +156,7 @@ fn shadow_polygons(
                 }
                 let prefilter_ns = t.elapsed().as_nanos() as u64;
                 let t = Instant::now();
-                let (mut tally, table, pairs) = project_onto(ctx, options, sample, b, candidates, proj, scratch, ring);
+                let (mut tally, table, pairs) = project_onto(ctx, options, sample, b, candidates, work);
                 tally.tested += tested;
                 tally.prefilter_ns += prefilter_ns;
                 tally.projection_ns += t.elapsed().as_nanos() as u64;
@@ -191,42 +200,42 @@ fn shadow_polygons(
 /// is worked on by all threads (ours), its candidates cut into pieces in order whose tables
 /// and pairs are appended in order: the table one thread would build, and no thread left to
 /// project a million casters alone.
-#[allow(clippy::too_many_arguments)]
 fn project_onto(
     ctx: &ShadowContext,
     options: BouknightKelleyOptions,
     sample: LightSample,
     b: u32,
     candidates: &[u32],
-    proj: &mut Projector,
-    scratch: &mut [Vec<DVec3>; 2],
-    ring: &mut Vec<DVec2>,
+    work: &mut Workspace,
 ) -> (Tally, ReceiverTable, Pairs) {
-    let parts: Vec<(Tally, ReceiverTable, Pairs)> = if candidates.len() > CASTERS_PER_PIECE {
-        candidates
-            .par_chunks(CASTERS_PER_PIECE)
-            .map_init(
-                || (Projector::default(), [Vec::new(), Vec::new()], Vec::new()),
-                |(proj, scratch, ring), piece| project_piece(ctx, options, sample, b, piece, proj, scratch, ring),
-            )
-            .collect()
-    } else {
-        vec![project_piece(ctx, options, sample, b, candidates, proj, scratch, ring)]
-    };
-    let mut tally = Tally::default();
-    let mut pairs = Pairs::default();
-    let mut tables = Vec::with_capacity(parts.len());
-    for (t, part, p) in parts {
+    if candidates.len() <= CASTERS_PER_PIECE {
+        let (tally, mut table, pairs) = project_piece(ctx, options, sample, b, candidates, work);
+        table.finish();
+        return (tally, table, pairs);
+    }
+    let parts: Vec<(Tally, ReceiverTable, Pairs)> = candidates
+        .par_chunks(CASTERS_PER_PIECE)
+        .map_init(Workspace::default, |work, piece| project_piece(ctx, options, sample, b, piece, work))
+        .collect();
+    let (mut tally, mut pairs, mut tables) = (Tally::default(), Pairs::default(), Vec::with_capacity(parts.len()));
+    for (t, table, p) in parts {
         tally.add(&t);
-        pairs.kept.extend(p.kept);
-        pairs.behind.extend(p.behind);
-        pairs.shadow_polygons.extend(p.shadow_polygons);
-        tables.push(part);
+        pairs.append(p);
+        tables.push(table);
     }
     let table = ReceiverTable::joined(tables);
     let mut table = table.unwrap_or_else(|| ReceiverTable::new(b, ctx.view.height, ctx.keep_outlines));
     table.finish();
     (tally, table, pairs)
+}
+
+/// One thread's scratch for projecting casters: the projector, the clipper's buffers and
+/// the screen ring.
+#[derive(Default)]
+struct Workspace {
+    proj: Projector,
+    scratch: [Vec<DVec3>; 2],
+    ring: Vec<DVec2>,
 }
 
 /// The most candidate casters of one receiver that one thread projects (see
@@ -235,18 +244,16 @@ const CASTERS_PER_PIECE: usize = 8192;
 
 /// Steps 2 and 3 for receiver `b` and the candidates `candidates` (all of them, or a piece),
 /// into an unfinished table.
-#[allow(clippy::too_many_arguments)]
 fn project_piece(
     ctx: &ShadowContext,
     options: BouknightKelleyOptions,
     sample: LightSample,
     b: u32,
     candidates: &[u32],
-    proj: &mut Projector,
-    scratch: &mut [Vec<DVec3>; 2],
-    ring: &mut Vec<DVec2>,
+    work: &mut Workspace,
 ) -> (Tally, ReceiverTable, Pairs) {
     let (scene, record) = (ctx.scene, ctx.keep_outlines);
+    let Workspace { proj, scratch, ring } = work;
     let mut tally = Tally::default();
     let mut table = ReceiverTable::new(b, ctx.view.height, record);
     let mut pairs = Pairs::default();
