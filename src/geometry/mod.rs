@@ -10,7 +10,7 @@ pub(crate) mod lone_sheets;
 mod rings;
 pub mod weiler_atherton;
 
-pub(crate) use rings::{RingList, Rings};
+pub(crate) use rings::{RingList, RingPieces, Rings};
 
 use glam::{DVec2, DVec3};
 

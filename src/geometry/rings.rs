@@ -3,10 +3,10 @@
 //! A shadow stage can put a million polygons on screen in a frame (Crow's volumes on s3). Kept
 //! as a list of lists, each outline is an allocation of its own, made on one thread and freed
 //! one by one, often on another. [`Rings`] keeps them all in one list of points and where
-//! each ends: the parallel loops that make them fill one list a piece, and the pieces' lists
-//! are joined in parallel ([`Rings::joined`]).
+//! each ends: the parallel loops that make them fill one list a piece, and the pieces are
+//! read as one list where they lie ([`RingPieces`]).
 
-use crate::pieces::{joined, starts};
+use crate::pieces::starts;
 use glam::DVec2;
 
 /// A list of rings read by index: a list of lists or [`Rings`].
@@ -56,14 +56,44 @@ impl Rings {
     pub fn iter(&self) -> impl Iterator<Item = &[DVec2]> + '_ {
         (0..self.count()).map(|i| self.ring(i))
     }
+}
 
-    /// The rings of every part, in order, in one list: each part is copied into its own
-    /// stretch of the list in parallel.
-    pub fn joined(parts: &[Rings]) -> Rings {
-        let offsets = starts(parts.iter().map(|p| p.points.len()));
-        let points: Vec<&[DVec2]> = parts.iter().map(|p| p.points.as_slice()).collect();
-        let ends: Vec<&[usize]> = parts.iter().map(|p| p.ends.as_slice()).collect();
-        Rings { points: joined(&points, |_, &p| p), ends: joined(&ends, |k, &end| end + offsets[k]) }
+/// Rings kept in the pieces a parallel loop made them in, read as one list: ring `i` is
+/// found by bisection over the pieces' first indices. Joining the pieces into one
+/// [`Rings`] would hold every point twice while it copies (z-fail's million caps on s3:
+/// 72 MB more at the frame's peak).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct RingPieces {
+    parts: Vec<Rings>,
+    /// `first[k]`: the index of part `k`'s first ring; one more entry, the count.
+    first: Vec<usize>,
+}
+
+impl RingPieces {
+    /// The rings of every part, in order.
+    pub fn new(parts: Vec<Rings>) -> RingPieces {
+        let first = starts(parts.iter().map(|p| p.count()));
+        let parts_and_first = parts.into_iter().zip(first).filter(|(p, _)| p.count() > 0);
+        let (parts, mut first): (Vec<Rings>, Vec<usize>) = parts_and_first.unzip();
+        first.push(parts.iter().map(|p| p.count()).sum());
+        RingPieces { parts, first }
+    }
+
+    /// The rings in order.
+    pub fn iter(&self) -> impl Iterator<Item = &[DVec2]> + '_ {
+        self.parts.iter().flat_map(|p| p.iter())
+    }
+}
+
+impl RingList for RingPieces {
+    fn count(&self) -> usize {
+        self.first.last().copied().unwrap_or(0)
+    }
+
+    fn ring(&self, i: usize) -> &[DVec2] {
+        // The last part whose first ring is at or before `i` (empty parts were left out).
+        let k = self.first.partition_point(|&f| f <= i) - 1;
+        self.parts[k].ring(i - self.first[k])
     }
 }
 
@@ -76,7 +106,7 @@ mod tests {
     }
 
     #[test]
-    fn rings_joined_from_parts_are_the_rings_pushed_in_order() {
+    fn rings_read_from_their_pieces_are_the_rings_pushed_in_order() {
         let sizes = [[3, 4, 0, 5].as_slice(), &[], &[7], &[3, 3]];
         let mut all = Rings::default();
         let mut k = 0;
@@ -92,10 +122,12 @@ mod tests {
                 rings
             })
             .collect();
-        let joined = Rings::joined(&parts);
-        assert_eq!(joined.count(), 7);
-        assert!(joined.iter().eq(all.iter()));
-        assert_eq!(joined.ring(4), ring(4, 7).as_slice());
-        assert!(joined.ring(2).is_empty());
+        let pieces = RingPieces::new(parts.clone());
+        assert_eq!(pieces.count(), 7);
+        assert!(pieces.iter().eq(all.iter()));
+        assert!((0..7).all(|i| pieces.ring(i) == all.ring(i)));
+        assert!(RingPieces::new(Vec::new()).iter().next().is_none());
+        assert_eq!(pieces.ring(4), ring(4, 7).as_slice());
+        assert!(pieces.ring(2).is_empty());
     }
 }

@@ -55,10 +55,15 @@ impl<'a> Crow<'a> {
         let samples = ctx
             .all_samples()
             .map(|(_, _, sample)| {
-                let volumes = ScreenVolumes::new(ctx, &adjacency, sample, options, counters);
-                let mut table = EdgeTable::new(view.height);
-                table.add_rings(&volumes.rings);
-                table.finish();
+                let mut volumes = ScreenVolumes::new(ctx, &adjacency, sample, options, counters);
+                // Sorted as it is made, with no unsorted list beside it (ours; z-fail puts
+                // more than two million edges into s3's table).
+                let table = EdgeTable::of_rings(view.height, &volumes.rings);
+                // The walk reads the table and the polygons' planes: the outlines are kept
+                // for a study alone (ours).
+                if !ctx.keep_outlines {
+                    volumes.rings = Default::default();
+                }
                 SampleVolumes { table, volumes }
             })
             .collect();

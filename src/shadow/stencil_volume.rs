@@ -7,11 +7,13 @@
 
 use super::volumes::{Adjacency, ScreenVolumes};
 use super::{Construction, Decision, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
-use crate::scan::{for_each_span, EdgeTable};
+use crate::geometry::RingList;
+use crate::scan::{for_each_span, lines_reached, EdgeTable};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
 use crate::visibility::Run;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// The prepared stage: every sample's lit mask.
 pub struct StencilVolume<'a> {
@@ -52,6 +54,10 @@ impl<'a> StencilVolume<'a> {
             .all_samples()
             .map(|(_, _, sample)| {
                 let vols = ScreenVolumes::new(ctx, &adjacency, sample, options, counters);
+                // The lines each shadow polygon reaches, so that a band draws only its own
+                // (ours: a tiled rasteriser's binning; z-fail puts a million caps on s3).
+                let reach: Vec<Range<u32>> =
+                    (0..vols.polys.len()).into_par_iter().map(|i| lines_reached(&[vols.rings.ring(i)], h)).collect();
                 let mut stencil = ctx.pools.i32.filled(w * h as usize, 0);
                 let written: u64 = stencil
                     .par_chunks_mut(w * band as usize)
@@ -61,7 +67,9 @@ impl<'a> StencilVolume<'a> {
                         let lines = y0..(y0 + band).min(h);
                         let mut table = EdgeTable::new(h);
                         let mut n = 0u64;
-                        for (sp, ring) in vols.polys.iter().zip(vols.rings.iter()) {
+                        let drawn = vols.polys.iter().zip(vols.rings.iter()).zip(&reach);
+                        let in_band = drawn.filter(|(_, r)| r.start < lines.end && lines.start < r.end);
+                        for ((sp, ring), _) in in_band {
                             for_each_span(&mut table, &[ring], view.width, h, lines.clone(), |y, x0, x1| {
                                 let yc = y as f64 + 0.5;
                                 for x in x0..x1 {

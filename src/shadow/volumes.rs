@@ -49,7 +49,7 @@
 
 use super::projection::{light_side, unseen, Projector, Target};
 use super::ShadowContext;
-use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane, Rings};
+use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane, RingPieces, Rings};
 use crate::pieces::joined;
 use crate::pool::Stash;
 use crate::scene::LightSample;
@@ -941,8 +941,8 @@ impl SightHull {
 pub struct ScreenVolumes {
     /// The polygons.
     pub polys: Vec<ScreenShadowPolygon>,
-    /// Their screen outlines, parallel to `polys`.
-    pub rings: Rings,
+    /// Their screen outlines, parallel to `polys`, in the pieces that made them.
+    pub rings: RingPieces,
 }
 
 impl ScreenVolumes {
@@ -1003,13 +1003,13 @@ impl ScreenVolumes {
         out
     }
 
-    /// The pieces' polygons in one list, in order: each piece copies its own into its
-    /// stretch, in parallel.
+    /// The pieces' polygons in one list, in order (each piece copies its own into its
+    /// stretch, in parallel); their outlines stay in their pieces.
     fn joined(pieces: Vec<Piece>) -> ScreenVolumes {
         let polys: Vec<&[ScreenShadowPolygon]> = pieces.iter().map(|p| p.polys.as_slice()).collect();
         let polys = joined(&polys, |_, &p| p);
-        let rings: Vec<Rings> = pieces.into_iter().map(|p| p.rings).collect();
-        ScreenVolumes { polys, rings: Rings::joined(&rings) }
+        let rings = RingPieces::new(pieces.into_iter().map(|p| p.rings).collect());
+        ScreenVolumes { polys, rings }
     }
 }
 
