@@ -8,7 +8,7 @@
 use super::volumes::{Adjacency, ScreenVolumes};
 use super::{Construction, Decision, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
 use crate::geometry::RingList;
-use crate::scan::{for_each_span, lines_reached, EdgeTable};
+use crate::scan::{bins, for_each_span, lines_reached, EdgeTable};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
 use crate::visibility::Run;
@@ -58,6 +58,8 @@ impl<'a> StencilVolume<'a> {
                 // (ours: a tiled rasteriser's binning; z-fail puts a million caps on s3).
                 let reach: Vec<Range<u32>> =
                     (0..vols.polys.len()).into_par_iter().map(|i| lines_reached(&[vols.rings.ring(i)], h)).collect();
+                let bins = bins(&reach, band, h);
+                drop(reach);
                 let mut stencil = ctx.pools.i32.filled(w * h as usize, 0);
                 let written: u64 = stencil
                     .par_chunks_mut(w * band as usize)
@@ -67,9 +69,8 @@ impl<'a> StencilVolume<'a> {
                         let lines = y0..(y0 + band).min(h);
                         let mut table = EdgeTable::new(h);
                         let mut n = 0u64;
-                        let drawn = vols.polys.iter().zip(vols.rings.iter()).zip(&reach);
-                        let in_band = drawn.filter(|(_, r)| r.start < lines.end && lines.start < r.end);
-                        for ((sp, ring), _) in in_band {
+                        for &i in &bins[bi] {
+                            let (sp, ring) = (&vols.polys[i as usize], vols.rings.ring(i as usize));
                             for_each_span(&mut table, &[ring], view.width, h, lines.clone(), |y, x0, x1| {
                                 let yc = y as f64 + 0.5;
                                 for x in x0..x1 {
