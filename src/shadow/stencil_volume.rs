@@ -73,12 +73,18 @@ impl<'a> StencilVolume<'a> {
                             let (sp, ring) = (&vols.polys[i as usize], vols.rings.ring(i as usize));
                             for_each_span(&mut table, &[ring], view.width, h, lines.clone(), |y, x0, x1| {
                                 let yc = y as f64 + 0.5;
+                                // The visible polygon's depth plane and face, looked up again
+                                // only where the polygon changes along the span (ours).
+                                let mut seen: (u32, Option<(DepthPlane, u32)>) = (u32::MAX, None);
                                 for x in x0..x1 {
                                     let k = y as usize * w + x as usize;
                                     let poly = surface[k];
-                                    let Some(Some(d)) = planes.get(poly as usize) else { continue };
+                                    if poly != seen.0 {
+                                        let plane = planes.get(poly as usize).copied().flatten();
+                                        seen = (poly, plane.map(|d| (d, scene.polygons[poly as usize].face)));
+                                    }
+                                    let Some((d, face)) = seen.1 else { continue };
                                     let xc = x as f64 + 0.5;
-                                    let face = scene.polygons[poly as usize].face;
                                     let c = sp.count_at(counting, poly, face, xc, yc, d.inv_z(xc, yc));
                                     rows[k - y0 as usize * w] += c;
                                     n += (c != 0) as u64;
