@@ -254,13 +254,10 @@ impl EdgeTable {
     /// lines, then works them out again and places them in its own stretch of the table, in
     /// the order added.
     pub(crate) fn of_rings<R: RingList + ?Sized>(height: u32, rings: &R) -> EdgeTable {
-        let reach: Vec<Range<u32>> =
-            (0..rings.count()).into_par_iter().map(|i| lines_reached(&[rings.ring(i)], height)).collect();
         let band = band_height(height);
         let bands: Vec<Range<u32>> =
             (0..height.div_ceil(band)).map(|b| b * band..((b + 1) * band).min(height)).collect();
-        let bins = bins(&reach, band, height);
-        drop(reach);
+        let bins = ring_bins(rings, band, height);
         // The edges of the rings reaching `lines` (band `b`) that start on them, in order.
         let starting = |(b, lines): (usize, &Range<u32>)| {
             let lines = lines.clone();
@@ -652,6 +649,14 @@ pub fn lines_reached(rings: &[&[DVec2]], height: u32) -> Range<u32> {
         return 0..0;
     }
     boundary(lo, height)..boundary(hi, height)
+}
+
+/// [`bins`] of `rings`: each band's rings, found from the lines each ring reaches
+/// ([`lines_reached`], worked out in parallel).
+pub(crate) fn ring_bins<R: RingList + ?Sized>(rings: &R, band: u32, height: u32) -> Vec<Vec<u32>> {
+    let reach: Vec<Range<u32>> =
+        (0..rings.count()).into_par_iter().map(|i| lines_reached(&[rings.ring(i)], height)).collect();
+    bins(&reach, band, height)
 }
 
 /// For each band of `band` lines from the top of an image `height` lines high, the indices of

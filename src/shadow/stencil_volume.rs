@@ -8,12 +8,11 @@
 use super::volumes::{Adjacency, ScreenVolumes};
 use super::{Construction, Decision, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
 use crate::geometry::RingList;
-use crate::scan::{bins, for_each_span, lines_reached, EdgeTable};
+use crate::scan::{for_each_span, ring_bins, EdgeTable};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
 use crate::visibility::Run;
 use rayon::prelude::*;
-use std::ops::Range;
 
 /// The prepared stage: every sample's lit mask.
 pub struct StencilVolume<'a> {
@@ -54,12 +53,10 @@ impl<'a> StencilVolume<'a> {
             .all_samples()
             .map(|(_, _, sample)| {
                 let vols = ScreenVolumes::new(ctx, &adjacency, sample, options, counters);
-                // The lines each shadow polygon reaches, so that a band draws only its own
-                // (ours: a tiled rasteriser's binning; z-fail puts a million caps on s3).
-                let reach: Vec<Range<u32>> =
-                    (0..vols.polys.len()).into_par_iter().map(|i| lines_reached(&[vols.rings.ring(i)], h)).collect();
-                let bins = bins(&reach, band, h);
-                drop(reach);
+                // Each band's shadow polygons, those whose lines reach it, so that a band draws
+                // only its own (ours: a tiled rasteriser's binning; z-fail puts a million caps
+                // on s3).
+                let bins = ring_bins(&vols.rings, band, h);
                 let mut stencil = ctx.pools.i32.filled(w * h as usize, 0);
                 let written: u64 = stencil
                     .par_chunks_mut(w * band as usize)
