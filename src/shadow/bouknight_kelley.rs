@@ -156,7 +156,8 @@ fn shadow_polygons(
                 }
                 let prefilter_ns = t.elapsed().as_nanos() as u64;
                 let t = Instant::now();
-                let (mut tally, table, pairs) = project_onto(ctx, options, sample, b, candidates, work);
+                let onto = Onto { ctx, options, sample, b };
+                let (mut tally, table, pairs) = project_onto(onto, candidates, work);
                 tally.tested += tested;
                 tally.prefilter_ns += prefilter_ns;
                 tally.projection_ns += t.elapsed().as_nanos() as u64;
@@ -191,7 +192,7 @@ fn shadow_polygons(
     (overlay, kept_pairs)
 }
 
-/// Steps 2 and 3 for receiver `b`: each candidate caster (not a piece of `b`'s own face) is
+/// Steps 2 and 3 for the receiver `onto` names, `b`: each candidate caster (not a piece of `b`'s own face) is
 /// projected from the light onto `b`'s plane and into the image, unless (ours, with their
 /// switches) it lies wholly behind `b` as the light sees it or outside `b`'s wedge. Returns
 /// the tally, the shadow polygons' edge table, and (for traces) what became of each pair.
@@ -200,22 +201,15 @@ fn shadow_polygons(
 /// is worked on by all threads (ours), its candidates cut into pieces in order whose tables
 /// and pairs are appended in order: the table one thread would build, and no thread left to
 /// project a million casters alone.
-fn project_onto(
-    ctx: &ShadowContext,
-    options: BouknightKelleyOptions,
-    sample: LightSample,
-    b: u32,
-    candidates: &[u32],
-    work: &mut Workspace,
-) -> (Tally, ReceiverTable, Pairs) {
+fn project_onto(onto: Onto, candidates: &[u32], work: &mut Workspace) -> (Tally, ReceiverTable, Pairs) {
     if candidates.len() <= CASTERS_PER_PIECE {
-        let (tally, mut table, pairs) = project_piece(ctx, options, sample, b, candidates, work);
+        let (tally, mut table, pairs) = project_piece(onto, candidates, work);
         table.finish();
         return (tally, table, pairs);
     }
     let parts: Vec<(Tally, ReceiverTable, Pairs)> = candidates
         .par_chunks(CASTERS_PER_PIECE)
-        .map_init(Workspace::default, |work, piece| project_piece(ctx, options, sample, b, piece, work))
+        .map_init(Workspace::default, |work, piece| project_piece(onto, piece, work))
         .collect();
     let (mut tally, mut pairs, mut tables) = (Tally::default(), Pairs::default(), Vec::with_capacity(parts.len()));
     for (t, table, p) in parts {
@@ -224,9 +218,20 @@ fn project_onto(
         tables.push(table);
     }
     let table = ReceiverTable::joined(tables);
+    let (b, ctx) = (onto.b, onto.ctx);
     let mut table = table.unwrap_or_else(|| ReceiverTable::new(b, ctx.view.height, ctx.keep_outlines));
     table.finish();
     (tally, table, pairs)
+}
+
+/// Whose shadows fall on which receiver: the frame, the stage's switches, the light sample
+/// and receiver `b`.
+#[derive(Clone, Copy)]
+struct Onto<'c> {
+    ctx: &'c ShadowContext<'c>,
+    options: BouknightKelleyOptions,
+    sample: LightSample,
+    b: u32,
 }
 
 /// One thread's scratch for projecting casters: the projector, the clipper's buffers and
@@ -242,16 +247,10 @@ struct Workspace {
 /// [`project_onto`]).
 const CASTERS_PER_PIECE: usize = 8192;
 
-/// Steps 2 and 3 for receiver `b` and the candidates `candidates` (all of them, or a piece),
+/// Steps 2 and 3 for the receiver `onto` names and the candidates `candidates` (all of them, or a piece),
 /// into an unfinished table.
-fn project_piece(
-    ctx: &ShadowContext,
-    options: BouknightKelleyOptions,
-    sample: LightSample,
-    b: u32,
-    candidates: &[u32],
-    work: &mut Workspace,
-) -> (Tally, ReceiverTable, Pairs) {
+fn project_piece(onto: Onto, candidates: &[u32], work: &mut Workspace) -> (Tally, ReceiverTable, Pairs) {
+    let Onto { ctx, options, sample, b } = onto;
     let (scene, record) = (ctx.scene, ctx.keep_outlines);
     let Workspace { proj, scratch, ring } = work;
     let mut tally = Tally::default();
