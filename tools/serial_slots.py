@@ -12,8 +12,8 @@ threads, then read the samples here:
 Time is cut into 1 ms slots. A worker thread is busy in a slot when it has a sample outside
 rayon's idle loop and the kernel's waiting; a slot in which one worker alone is busy is a
 serial slot. The busy worker's samples there are counted by their first three frames in
-umbra (leaf first). Samples before the first frame's view (`clip_project`), the scene's
-loading, are left out; the warm-up frame is not. A parallel loop's last piece, run while the
+umbra (leaf first). Samples before the first frame (`render::frame_pass` on a worker), the
+scene's loading, are left out; the warm-up frame is not. A parallel loop's last piece, run while the
 other thread waits, counts as serial too: for Amdahl's law it is.
 """
 import collections
@@ -26,7 +26,7 @@ IDLE = re.compile(
     r"|__lll|try_to_wake|finish_task_switch"
 )
 HEADER = re.compile(r"\s*(\d+)\s+([\d.]+):")
-FRAME = re.compile(r"\s+[0-9a-f]+\s+(.*?)\s+\((.*)\)\s*$")
+FRAME = re.compile(r"\s+[0-9a-f]+\s+(.*?)(?:\s+\((.*)\))?\s*$")
 
 
 def samples(lines):
@@ -57,11 +57,11 @@ def main():
     for tid, t, stack in all_samples:
         if tid == main_thread or not stack:
             continue
-        started = started or any("clip_project" in s for s in stack)
+        started = started or any("render::frame_pass" in s for s in stack)
         if started:
             slots[int(t * 1000)][tid].append(stack)
     if not slots:
-        sys.exit("no frame found (no sample in clip_project)")
+        sys.exit("no frame found (no worker sample in render::frame_pass)")
     workers = sorted({tid for slot in slots.values() for tid in slot})
     busy = lambda stacks: [s for s in stacks if not IDLE.search(s[0])]
     serial, counts = collections.Counter(), collections.Counter()
