@@ -152,6 +152,15 @@ impl Stash {
         }
     }
 
+    /// Lets go of every kept `T` (working memory a stage has done with for this frame).
+    pub(crate) fn discard<T: Any + Send>(&self) {
+        let gone: Vec<Box<dyn Any + Send>> = match self.0.lock() {
+            Ok(mut kept) => kept.extract_if(.., |b| b.is::<T>()).collect(),
+            Err(_) => Vec::new(),
+        };
+        drop(gone);
+    }
+
     /// Keeps `item` for a later frame.
     pub(crate) fn put<T: Any + Send>(&self, item: T) {
         if let Ok(mut kept) = self.0.lock() {
@@ -227,6 +236,17 @@ impl Pools {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_stash_discards_every_kept_item_of_one_type() {
+        let stash = Stash::default();
+        stash.put(vec![1u8]);
+        stash.put(String::from("kept"));
+        stash.put(vec![2u8]);
+        stash.discard::<Vec<u8>>();
+        assert_eq!(stash.take::<Vec<u8>>(), Vec::<u8>::new(), "both let go");
+        assert_eq!(stash.take::<String>(), "kept", "other types stay");
+    }
 
     #[test]
     fn a_leased_buffer_comes_back_when_dropped() {

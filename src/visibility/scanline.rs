@@ -44,6 +44,14 @@ struct BandScratch {
     set: OpenSet,
 }
 
+/// The bands' working memory is let go with the stage: kept, it would sit through the shadow
+/// stage's preparation, when the frame's memory peaks (27 MB of band tables on s3).
+impl Drop for ScanlineVisibility<'_> {
+    fn drop(&mut self) {
+        self.stash.discard::<BandScratch>();
+    }
+}
+
 impl<'a> ScanlineVisibility<'a> {
     /// Sorts the polygons of `screen` into the bands they reach; band tables are kept in
     /// `pools`.
