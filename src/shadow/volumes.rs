@@ -151,17 +151,15 @@ fn shadow_polygons(
     // Step 1: the merged sides, one per edge whose net weight is not zero. Each edge and
     // each polygon is decided on its own, so they are worked out in parallel, in order.
     let mut pieces: Vec<Piece> = adjacency
-        .edges
-        .par_chunks(PIECE)
+        .edge_pieces()
         .map_init(Scratch::default, |scratch, edges| {
             let mut piece = Piece::default();
-            for e in edges {
-                let sharing = &adjacency.sharing[e.first as usize..(e.first + e.count) as usize];
-                if !sharing.iter().any(|s| casts(s.poly as usize)) {
+            for (e, sharing) in edges {
+                if !sharing.iter().any(|s| casts(s.poly())) {
                     continue; // no polygon on it casts: no side
                 }
                 let (ea, eb) = e.ends(ctx.scene);
-                let w = b.net_weight(ea, eb, sharing.iter().filter(|s| casts(s.poly as usize)));
+                let w = b.net_weight(ea, eb, sharing.iter().filter(|s| casts(s.poly())));
                 let side = b.side(ea, eb, w, None);
                 if side.is_some() {
                     piece.weights[usize::from(w.abs() != 1)] += 1;
@@ -228,21 +226,19 @@ fn crow_1977(
         .into_par_iter()
         .map(|i| scene.casts_shadows(i) && sample.side_of(&scene.polygons[i].plane) > 0.0)
         .collect();
-    let object = |s: &Sharing| scene.polygons[s.poly as usize].object;
+    let object = |s: &Sharing| scene.polygons[s.poly()].object;
     // Step 2, edge by edge and object by object.
     let mut pieces: Vec<Piece> = adjacency
-        .edges
-        .par_chunks(PIECE)
+        .edge_pieces()
         .map_init(Scratch::default, |scratch, edges| {
             let mut piece = Piece::default();
-            for e in edges {
-                let sharing = &adjacency.sharing[e.first as usize..(e.first + e.count) as usize];
+            for (e, sharing) in edges {
                 for (k, first) in sharing.iter().enumerate() {
                     if sharing[..k].iter().any(|s| object(s) == object(first)) {
                         continue; // this object's contour was decided already
                     }
                     let of_object = || sharing.iter().filter(|s| object(s) == object(first));
-                    let lit = || of_object().filter(|s| facing[s.poly as usize]);
+                    let lit = || of_object().filter(|s| facing[s.poly()]);
                     let (lit_count, all) = (lit().count(), of_object().count());
                     // A contour edge: one turned to the light meets one turned away, or
                     // an edge of one polygon turned to the light meets nothing.
@@ -402,9 +398,9 @@ impl<'c> Builder<'c> {
     fn net_weight<'s>(&self, a: DVec3, b: DVec3, sharing: impl Iterator<Item = &'s Sharing>) -> i32 {
         let m = self.edge_plane(a, b);
         sharing
-            .map(|s| {
-                let (from, to) = if s.forward { (a, b) } else { (b, a) };
-                self.orientation(m, from, to, s.poly as usize)
+            .map(|&s| {
+                let (from, to) = if s.forward() { (a, b) } else { (b, a) };
+                self.orientation(m, from, to, s.poly())
             })
             .sum()
     }
@@ -559,7 +555,8 @@ pub struct Adjacency {
     merged_volumes: bool,
     /// Every edge of a merged polygon, once.
     edges: Vec<MergedEdge>,
-    /// The polygons sharing each edge (`edges[i].first..+count`).
+    /// The polygons sharing each edge: edge `i`'s from `edges[i].first` to the next edge's
+    /// first.
     sharing: Vec<Sharing>,
     /// The merged polygons (their caps).
     merged: Vec<u32>,
@@ -569,13 +566,12 @@ pub struct Adjacency {
 
 /// An edge between two vertex positions, the lesser (by their bits) first: `a` and `b` index
 /// [`Scene::vertices`](crate::scene::Scene) (a corner of one polygon on it), so that the edge
-/// costs 16 bytes, not 56.
+/// costs 12 bytes, not 56; `first`, where its polygons start in [`Adjacency::sharing`].
 #[derive(Debug, Clone, Copy)]
 struct MergedEdge {
     a: u32,
     b: u32,
     first: u32,
-    count: u32,
 }
 
 impl MergedEdge {
@@ -585,11 +581,26 @@ impl MergedEdge {
     }
 }
 
-/// A polygon on an edge: it runs `a → b` (`forward`) or `b → a`.
+/// A polygon on an edge, and whether it runs the edge `a → b` (forward) or `b → a`: the
+/// polygon's index in the low 31 bits, the direction in the top bit (four bytes, not
+/// eight: s3's three million are 12 MB; a polygon numbered past 2³¹ keeps its own volume).
 #[derive(Debug, Clone, Copy)]
-struct Sharing {
-    poly: u32,
-    forward: bool,
+struct Sharing(u32);
+
+impl Sharing {
+    const FORWARD: u32 = 1 << 31;
+
+    fn new(poly: u32, forward: bool) -> Sharing {
+        Sharing(poly | if forward { Sharing::FORWARD } else { 0 })
+    }
+
+    fn poly(self) -> usize {
+        (self.0 & !Sharing::FORWARD) as usize
+    }
+
+    fn forward(self) -> bool {
+        self.0 & Sharing::FORWARD != 0
+    }
 }
 
 /// A volume kept apart: a fan piece, or one trapezoid of a self-intersecting polygon.
@@ -656,7 +667,7 @@ impl Adjacency {
             let crossing = (verts.len() >= 4).then(ring).filter(|r| even_odd::self_intersects(r));
             if let Some(ring) = crossing {
                 adjacency.keep_apart_even_odd(p, &ring, axis, &poly.plane);
-            } else if !merge || fan_piece {
+            } else if !merge || fan_piece || p >= Sharing::FORWARD as usize {
                 adjacency.apart.push(Apart { poly: p as u32, verts: verts.to_vec() });
             } else {
                 adjacency.merged.push(p as u32);
@@ -735,13 +746,24 @@ impl Adjacency {
             if i == 0 || keyed[i - 1].hash != k.hash {
                 let (a, b) = ((k.hash >> 32) as u32, k.hash as u32);
                 let first = self.sharing.len() as u32;
-                self.edges.push(MergedEdge { a, b, first, count: 0 });
+                self.edges.push(MergedEdge { a, b, first });
             }
-            self.sharing.push(Sharing { poly: k.poly, forward });
-            if let Some(e) = self.edges.last_mut() {
-                e.count += 1;
-            }
+            self.sharing.push(Sharing::new(k.poly, forward));
         }
+    }
+
+    /// The polygons on merged edge `i`.
+    fn sharing_of(&self, i: usize) -> &[Sharing] {
+        let end = self.edges.get(i + 1).map_or(self.sharing.len(), |e| e.first as usize);
+        &self.sharing[self.edges[i].first as usize..end]
+    }
+
+    /// The merged edges with the polygons on each, in pieces of at most [`PIECE`], in order.
+    fn edge_pieces(&self) -> impl IndexedParallelIterator<Item = impl Iterator<Item = (&MergedEdge, &[Sharing])>> {
+        let n = self.edges.len();
+        (0..n.div_ceil(PIECE))
+            .into_par_iter()
+            .map(move |c| (c * PIECE..n.min((c + 1) * PIECE)).map(move |i| (&self.edges[i], self.sharing_of(i))))
     }
 }
 
