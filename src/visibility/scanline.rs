@@ -30,11 +30,11 @@ pub struct ScanlineVisibility<'a> {
     band: u32,
     width: u32,
     height: u32,
-    /// Where the bands' working memory is kept between frames.
+    /// Where the bands' working memory is kept from band to band (let go with the stage).
     stash: Stash,
 }
 
-/// One band's working memory, kept between frames: its edge table, and its polygons' depth
+/// One band's working memory, kept for the next band: its edge table, and its polygons' depth
 /// planes and scene indices (the table's tags index these), and the set of open polygons.
 #[derive(Default)]
 struct BandScratch {
