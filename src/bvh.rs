@@ -30,6 +30,11 @@ fn bounds(scene: &Scene, i: u32) -> (DVec3, DVec3) {
 }
 
 impl Bvh {
+    /// The bytes it holds.
+    pub fn bytes(&self) -> usize {
+        crate::pool::held(&self.nodes) + crate::pool::held(&self.items)
+    }
+
     /// Builds the hierarchy over polygons `items` of `scene`.
     pub fn new(scene: &Scene, items: Vec<u32>) -> Bvh {
         let boxes: Vec<(DVec3, DVec3)> = (0..scene.polygons.len() as u32).map(|i| bounds(scene, i)).collect();

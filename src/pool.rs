@@ -136,6 +136,11 @@ impl Kept<crate::frame::Frame> {
     }
 }
 
+/// The bytes a list holds (its capacity, not its length).
+pub(crate) fn held<T>(list: &Vec<T>) -> usize {
+    list.capacity() * std::mem::size_of::<T>()
+}
+
 /// Things of any type kept for reuse, found by their type: what a stage keeps for its next
 /// frame in types of its own (a band's edge table, the screen polygons, an edge adjacency),
 /// which this module need not know.

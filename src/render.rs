@@ -339,6 +339,7 @@ fn frame_pass(
         shadows = Box::new(soft_edged(&ctx, shadows.as_ref(), soft)?);
     }
     stats.time_ms.shadow_prepare = ms(t.elapsed());
+    stats.shadow_counters.add(crate::stats::Counter::StageBytes, shadows.bytes() as u64);
 
     let t = Instant::now();
     let (lights, background) = (scene.lights.len(), scene.render.background);

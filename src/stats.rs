@@ -107,6 +107,10 @@ counters! {
     BandBytesMax = "band_bytes_max",
     /// Z-buffer: depth writes.
     DepthWrites = "depth_writes",
+    /// Every shadow stage: the bytes its prepared stage holds through the walk (shadow
+    /// polygons' edge tables, planes and outlines, detail polygons, depth maps, masks and
+    /// buffers, a ray-caster's hierarchy), the walkers' per-band scratch not included.
+    StageBytes = "stage_bytes",
     /// Z-buffer: the bytes of its depth and id buffers.
     BufferBytes = "buffer_bytes",
     /// Ray-cast visibility: the rays cast, one per pixel.

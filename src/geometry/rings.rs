@@ -46,6 +46,11 @@ impl RingList for Rings {
 }
 
 impl Rings {
+    /// The bytes it holds.
+    pub fn bytes(&self) -> usize {
+        crate::pool::held(&self.points) + crate::pool::held(&self.ends)
+    }
+
     /// Adds a ring at the end.
     pub fn push(&mut self, ring: &[DVec2]) {
         self.points.extend_from_slice(ring);
@@ -70,6 +75,11 @@ pub(crate) struct RingPieces {
 }
 
 impl RingPieces {
+    /// The bytes its parts hold.
+    pub fn bytes(&self) -> usize {
+        self.parts.iter().map(Rings::bytes).sum::<usize>() + crate::pool::held(&self.first)
+    }
+
     /// The rings of every part, in order.
     pub fn new(parts: Vec<Rings>) -> RingPieces {
         let first = starts(parts.iter().map(|p| p.count()));

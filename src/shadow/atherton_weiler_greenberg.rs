@@ -1388,6 +1388,11 @@ fn grouped_by_source(screen: &[(u32, Vec<Vec<DVec2>>)]) -> Vec<(u32, Vec<u32>)> 
 }
 
 impl ShadowStage for AthertonWeilerGreenberg<'_> {
+    /// The detail polygons' overlays (a database kept by the renderer is not counted).
+    fn bytes(&self) -> usize {
+        self.detail.iter().map(Overlay::bytes).sum()
+    }
+
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
         Box::new(CoverWalker::new(self.ctx, &self.detail, 1.0, 0.0, "lit detail polygon"))
     }

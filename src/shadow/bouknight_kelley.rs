@@ -663,6 +663,12 @@ fn sphere_boxes(cone: &Cone) -> Boxes {
 }
 
 impl ShadowStage for BouknightKelley<'_> {
+    /// The shadow polygons' overlays (what became of the pairs, kept for traces, is not
+    /// counted).
+    fn bytes(&self) -> usize {
+        self.shadows.iter().map(Overlay::bytes).sum()
+    }
+
     fn outlines(&self) -> Vec<Vec<DVec2>> {
         self.shadows.first().map_or_else(Vec::new, |o| o.rings().to_vec())
     }

@@ -72,6 +72,10 @@ impl<'a> Crow<'a> {
 }
 
 impl ShadowStage for Crow<'_> {
+    fn bytes(&self) -> usize {
+        self.samples.iter().map(|s| s.table.bytes() + s.volumes.bytes()).sum()
+    }
+
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
         let h = self.ctx.view.height;
         Box::new(Walker {

@@ -410,6 +410,9 @@ pub(crate) trait ShadowStage: Sync {
     fn outlines(&self) -> Vec<Vec<glam::DVec2>> {
         Vec::new()
     }
+
+    /// The bytes the prepared stage holds through the walk (`--stats`' `stage_bytes`).
+    fn bytes(&self) -> usize;
 }
 
 /// Answers, line by line, which pixels of each visible run a light sample reaches.
@@ -988,6 +991,10 @@ struct NoShadows;
 impl ShadowStage for NoShadows {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
         Box::new(NoShadows)
+    }
+
+    fn bytes(&self) -> usize {
+        0
     }
 }
 

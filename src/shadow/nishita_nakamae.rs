@@ -899,6 +899,16 @@ fn clip_convex(subject: &[DVec2], by: &[DVec2], out: &mut Vec<DVec2>, tmp: &mut 
 }
 
 impl ShadowStage for NishitaNakamae<'_> {
+    /// The umbra and penumbra overlays and what step 5 keeps beside them.
+    fn bytes(&self) -> usize {
+        use crate::pool::held;
+        let light = |l: &LightShadows| {
+            let everywhere = l.everywhere.values().map(|(c, _)| held(c) + 32).sum::<usize>();
+            l.umbra.bytes() + l.penumbra.bytes() + held(&l.occluder) + held(&l.bodies) + everywhere
+        };
+        self.lights.iter().map(light).sum()
+    }
+
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
         let height = self.ctx.view.height;
         Box::new(Walker {

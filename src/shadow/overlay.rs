@@ -126,6 +126,18 @@ impl ReceiverTable {
 }
 
 impl Overlay {
+    /// The bytes it holds: its tables, their receivers' slots, and the outlines it keeps.
+    pub fn bytes(&self) -> usize {
+        use crate::pool::held;
+        let rings = self.rings.iter().map(held).sum::<usize>() + held(&self.rings);
+        self.tables.iter().map(EdgeTable::bytes).sum::<usize>()
+            + held(&self.tables)
+            + held(&self.base)
+            + held(&self.tags)
+            + held(&self.slot)
+            + rings
+    }
+
     /// An empty overlay for an image `height` lines high; `keep_rings` keeps each polygon's
     /// outline for drawing (`--debug`).
     pub fn new(height: u32, keep_rings: bool) -> Self {

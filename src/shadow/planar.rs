@@ -123,6 +123,10 @@ impl<'a> Planar<'a> {
 }
 
 impl ShadowStage for Planar<'_> {
+    fn bytes(&self) -> usize {
+        self.shadows.iter().map(Overlay::bytes).sum()
+    }
+
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
         Box::new(CoverWalker::new(self.ctx, &self.shadows, 0.0, 1.0, "flattened caster"))
     }

@@ -47,6 +47,10 @@ impl ShadowStage for RayCastShadows<'_> {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
         Box::new(Walker { stage: self, rays: 0, last: (0, 0) })
     }
+
+    fn bytes(&self) -> usize {
+        self.bvh.bytes()
+    }
 }
 
 impl ShadowWalker for Walker<'_> {

@@ -249,6 +249,14 @@ impl super::ShadowStage for SoftEdged {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
         Box::new(Reader { stage: self })
     }
+
+    /// The blurred screen buffers (the stage they were walked from is let go).
+    fn bytes(&self) -> usize {
+        match &self.held {
+            Held::PerSample(buffers) => buffers.iter().map(crate::pool::held).sum(),
+            Held::Shared(buffer) => buffer.as_ref().map_or(0, |(_, b)| crate::pool::held(b)),
+        }
+    }
 }
 
 struct Reader<'s> {

@@ -117,6 +117,11 @@ impl ShadowStage for StencilVolume<'_> {
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
         Box::new(Walker { stage: self })
     }
+
+    /// The lit masks (the shadow volumes are let go once drawn).
+    fn bytes(&self) -> usize {
+        self.lit.iter().map(crate::pool::held).sum()
+    }
 }
 
 struct Walker<'s> {

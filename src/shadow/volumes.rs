@@ -968,6 +968,11 @@ pub struct ScreenVolumes {
 }
 
 impl ScreenVolumes {
+    /// The bytes it holds: the polygons and their outlines.
+    pub(crate) fn bytes(&self) -> usize {
+        crate::pool::held(&self.polys) + self.rings.bytes()
+    }
+
     /// The shadow polygons of `sample` built and counted as `options` say, put through the
     /// camera: clipped to the near plane in homogeneous coordinates and projected. With the
     /// sight cuts (ours) they are never clipped to the camera's far plane; without them, as

@@ -925,6 +925,16 @@ impl<'a> Williams<'a> {
 }
 
 impl ShadowStage for Williams<'_> {
+    /// The depth maps, and the soft-edge filter's screen buffers.
+    fn bytes(&self) -> usize {
+        let map = |m: &DepthMap| crate::pool::held(&m.nearness);
+        let maps = self.maps.iter().map(|m| match m {
+            LightMaps::Single(m) => map(m),
+            LightMaps::Cube(faces, _) => faces.iter().map(map).sum(),
+        });
+        maps.sum::<usize>() + self.blurred.iter().map(crate::pool::held).sum::<usize>()
+    }
+
     fn pictures(&self) -> Vec<super::Picture> {
         let mut out = Vec::new();
         for (light, sample, _) in self.ctx.all_samples() {

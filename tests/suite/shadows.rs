@@ -964,3 +964,25 @@ fn every_registered_stage_is_named_described_configured_and_checked() {
         }
     }
 }
+
+/// `stage_bytes` counts what a prepared stage holds through the walk: nothing without
+/// shadows; for Crow at least its shadow polygons' records (a depth plane, a sign and two
+/// polygon numbers: 40 bytes each), more with z-fail's caps than with z-pass; something for
+/// every other stage.
+#[test]
+fn stage_bytes_count_what_each_stage_holds() {
+    use umbra::shadow::{Counting, VolumeOptions};
+    let scene = umbra::generate::cubes(3, umbra::generate::Faces::Quads, 160, 120).unwrap();
+    let run = |shadows| umbra::render(&scene, &umbra::RenderOptions { shadows, ..Default::default() }).unwrap();
+    let bytes = |r: &umbra::Rendered| r.stats.shadow_counters.get(umbra::Counter::StageBytes);
+    assert_eq!(bytes(&run(ShadowMethod::None)), 0);
+    let crow = |counting| run(ShadowMethod::Crow(VolumeOptions { counting, ..Default::default() }));
+    let (z_pass, z_fail) = (crow(Counting::ZPass), crow(Counting::ZFail));
+    let polygons = z_pass.stats.shadow_counters.get(umbra::Counter::ScreenShadowPolygons);
+    assert!(polygons > 0 && bytes(&z_pass) >= 40 * polygons, "{} bytes, {polygons} polygons", bytes(&z_pass));
+    assert!(bytes(&z_fail) > bytes(&z_pass), "z-fail {} against z-pass {}", bytes(&z_fail), bytes(&z_pass));
+    for (label, shadows) in common::exact_stages().into_iter().chain([("williams".into(), "williams".parse().unwrap())])
+    {
+        assert!(bytes(&run(shadows)) > 0, "{label}");
+    }
+}
