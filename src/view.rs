@@ -78,13 +78,16 @@ const PART_BITS: u32 = 12;
 /// allocation each would cost more than clipping them). The parts are clipped in parallel
 /// and kept as they are, not joined into one list (a second copy of the screen, 43 MB on s3):
 /// a polygon's number is its part's number, then its place in the part ([`PART_BITS`]), so
-/// numbers increase in the order of the scene's polygons but are not all used. The parts are
-/// kept with the screen, so that the next frame clips into memory it already has.
+/// numbers increase in the order of the scene's polygons but are not all used. A frame lets
+/// its screen go once its visible runs are found ([`Screen::let_go`]), keeping only each
+/// part's size, so that the next frame makes each part in one allocation.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Screen {
     parts: Vec<Part>,
     /// The parts in use (the rest are kept memory).
     used: usize,
+    /// Each part's polygons and points in the screen let go last (see [`Screen::let_go`]).
+    sizes: Vec<(usize, usize)>,
 }
 
 /// One part of a [`Screen`].
@@ -108,6 +111,14 @@ impl Part {
 }
 
 impl Screen {
+    /// An empty screen that remembers only the size of each of this one's parts: what a
+    /// frame keeps for the next, so that the screen's memory (62 MB on s3) does not sit
+    /// through the shadow preparation, and the next frame still grows no list.
+    pub fn let_go(self) -> Screen {
+        let sizes = self.parts[..self.used].iter().map(|p| (p.polygons.len(), p.points.len())).collect();
+        Screen { parts: Vec::new(), used: 0, sizes }
+    }
+
     /// Adds scene polygon `poly` with its screen `ring` and inverse depth.
     pub fn push(&mut self, poly: u32, ring: &[DVec2], depth: DepthPlane) {
         if self.used == 0 || self.parts[self.used - 1].polygons.len() >> PART_BITS != 0 {
@@ -396,10 +407,14 @@ impl View {
         if kept.parts.len() < kept.used {
             kept.parts.resize_with(kept.used, Part::default);
         }
-        let parts = &mut kept.parts[..kept.used];
+        let (parts, sizes) = (&mut kept.parts[..kept.used], &kept.sizes);
         scene.polygons.par_chunks(CHUNK).zip(parts.par_iter_mut()).enumerate().for_each(|(c, (polygons, part))| {
             let (mut scratch, mut ring) = ([Vec::new(), Vec::new()], Vec::new());
             part.clear();
+            if let Some(&(n, points)) = sizes.get(c) {
+                part.polygons.reserve(n);
+                part.points.reserve(points);
+            }
             for (i, p) in (c * CHUNK..).zip(polygons).filter(|&(i, _)| keep(i)) {
                 let Some(depth) = self.depth_plane(&p.plane) else {
                     continue;
@@ -432,6 +447,26 @@ mod tests {
         let d = v.ray(s.x, s.y);
         let c = v.to_camera(p);
         assert!((v.eye + c.z * d - p).length() < 1e-12);
+    }
+
+    #[test]
+    fn a_screen_let_go_keeps_its_sizes_and_the_next_is_the_same() {
+        let scene = crate::generate::cubes(3, crate::generate::Faces::Quads, 64, 48).unwrap();
+        let view = View::new(&scene.camera);
+        let first = view.screen_polygons_in(&scene, |_| true, Screen::default());
+        let listed = |s: &Screen| s.iter().map(|(i, p, r)| (i, p.poly, r.to_vec())).collect::<Vec<_>>();
+        let before = listed(&first);
+        assert!(!before.is_empty());
+        let sizes: Vec<(usize, usize)> =
+            first.parts[..first.used].iter().map(|p| (p.polygons.len(), p.points.len())).collect();
+        let kept = first.let_go();
+        assert!(kept.parts.is_empty(), "the parts' memory is let go");
+        assert_eq!(kept.sizes, sizes);
+        let again = view.screen_polygons_in(&scene, |_| true, kept);
+        assert_eq!(listed(&again), before);
+        for (part, &(n, points)) in again.parts.iter().zip(&sizes) {
+            assert!(part.polygons.capacity() >= n && part.points.capacity() >= points, "made at its size");
+        }
     }
 
     #[test]
