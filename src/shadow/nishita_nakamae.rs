@@ -902,8 +902,11 @@ impl ShadowStage for NishitaNakamae<'_> {
     /// The umbra and penumbra overlays and what step 5 keeps beside them.
     fn bytes(&self) -> usize {
         use crate::pool::held;
+        // The map's slots (an entry and a control byte each) and the casters' lists.
+        let slot = std::mem::size_of::<(u32, (Vec<u32>, bool))>() + 1;
         let light = |l: &LightShadows| {
-            let everywhere = l.everywhere.values().map(|(c, _)| held(c) + 32).sum::<usize>();
+            let everywhere =
+                l.everywhere.capacity() * slot + l.everywhere.values().map(|(c, _)| held(c)).sum::<usize>();
             l.umbra.bytes() + l.penumbra.bytes() + held(&l.occluder) + held(&l.bodies) + everywhere
         };
         self.lights.iter().map(light).sum()
