@@ -13,7 +13,7 @@ use crate::scene::Scene;
 use crate::shading::{LineShading, Shader};
 use crate::shadow::{ShadowContext, ShadowDatabase, ShadowMethod};
 use crate::stats::{Counters, Stats};
-use crate::view::{Screen, View};
+use crate::view::{Screen, ScreenSizes, View};
 use crate::visibility::{FrameRuns, VisibilityMethod};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -312,7 +312,8 @@ fn frame_pass(
         let solid = scene.solid_of[i] as usize;
         !(opts.back_face_cull && whole.get(solid) == Some(&true) && scene.turned_away_on_solid(i, eye, &closed))
     };
-    let screen = view.screen_polygons_in(scene, seen, pools.stash.take());
+    let sizes: ScreenSizes = pools.stash.take();
+    let screen = view.screen_polygons_in(scene, seen, Screen::sized(sizes));
     stats.visibility_counters.add(crate::stats::Counter::ScreenPolygons, screen.len() as u64);
     stats.time_ms.view = ms(t.elapsed());
 
@@ -322,7 +323,8 @@ fn frame_pass(
     stats.time_ms.visibility = ms(t.elapsed());
     // The screen polygons are done with: let go now, not kept for the next frame, so that
     // they do not sit through the shadow preparation, where the frame's memory peaks (62 MB
-    // on s3); the next frame is told each part's size.
+    // on s3); the next frame is told each part's size (Williams' light views keep screens of
+    // their own in the stash).
     pools.stash.put(screen.let_go());
 
     let t = Instant::now();

@@ -665,8 +665,8 @@ pub(crate) fn ring_bins<R: RingList + ?Sized>(rings: &R, band: u32, height: u32)
 /// on s3, read by eighteen bands, twice each). Worked out by pieces of the rings in
 /// parallel, each piece's lists joined in order.
 pub(crate) fn bins(reach: &[Range<u32>], band: u32, height: u32) -> Vec<Vec<u32>> {
-    let count = height.div_ceil(band.max(1)) as usize;
     let band = band.max(1);
+    let count = height.div_ceil(band) as usize;
     let pieces: Vec<Vec<Vec<u32>>> = reach
         .par_chunks(1 << 16)
         .enumerate()

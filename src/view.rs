@@ -79,16 +79,20 @@ const PART_BITS: u32 = 12;
 /// and kept as they are, not joined into one list (a second copy of the screen, 43 MB on s3):
 /// a polygon's number is its part's number, then its place in the part ([`PART_BITS`]), so
 /// numbers increase in the order of the scene's polygons but are not all used. A frame lets
-/// its screen go once its visible runs are found ([`Screen::let_go`]), keeping only each
-/// part's size, so that the next frame makes each part in one allocation.
+/// the camera's screen go once its visible runs are found, keeping only each part's size
+/// ([`ScreenSizes`]), so that the next frame makes each part in one allocation.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Screen {
     parts: Vec<Part>,
     /// The parts in use (the rest are kept memory).
     used: usize,
-    /// Each part's polygons and points in the screen let go last (see [`Screen::let_go`]).
+    /// Each part's polygons and points in a screen let go before ([`Screen::sized`]).
     sizes: Vec<(usize, usize)>,
 }
+
+/// The size of each part of a screen let go ([`Screen::let_go`]): polygons and points.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct ScreenSizes(Vec<(usize, usize)>);
 
 /// One part of a [`Screen`].
 #[derive(Debug, Clone, Default)]
@@ -111,12 +115,16 @@ impl Part {
 }
 
 impl Screen {
-    /// An empty screen that remembers only the size of each of this one's parts: what a
-    /// frame keeps for the next, so that the screen's memory (62 MB on s3) does not sit
-    /// through the shadow preparation, and the next frame still grows no list.
-    pub fn let_go(self) -> Screen {
-        let sizes = self.parts[..self.used].iter().map(|p| (p.polygons.len(), p.points.len())).collect();
-        Screen { parts: Vec::new(), used: 0, sizes }
+    /// Lets the screen's memory go, keeping the size of each part: what a frame keeps for
+    /// the next, so that the screen (62 MB on s3) does not sit through the shadow
+    /// preparation, and the next frame still grows no list ([`Screen::sized`]).
+    pub fn let_go(self) -> ScreenSizes {
+        ScreenSizes(self.parts[..self.used].iter().map(|p| (p.polygons.len(), p.points.len())).collect())
+    }
+
+    /// An empty screen whose parts [`View::screen_polygons_in`] makes at `sizes`.
+    pub fn sized(sizes: ScreenSizes) -> Screen {
+        Screen { sizes: sizes.0, ..Screen::default() }
     }
 
     /// Adds scene polygon `poly` with its screen `ring` and inverse depth.
@@ -460,9 +468,8 @@ mod tests {
         let sizes: Vec<(usize, usize)> =
             first.parts[..first.used].iter().map(|p| (p.polygons.len(), p.points.len())).collect();
         let kept = first.let_go();
-        assert!(kept.parts.is_empty(), "the parts' memory is let go");
-        assert_eq!(kept.sizes, sizes);
-        let again = view.screen_polygons_in(&scene, |_| true, kept);
+        assert_eq!(kept, ScreenSizes(sizes.clone()));
+        let again = view.screen_polygons_in(&scene, |_| true, Screen::sized(kept));
         assert_eq!(listed(&again), before);
         for (part, &(n, points)) in again.parts.iter().zip(&sizes) {
             assert!(part.polygons.capacity() >= n && part.points.capacity() >= points, "made at its size");
