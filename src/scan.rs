@@ -245,6 +245,14 @@ impl EdgeTable {
         self.built = false;
     }
 
+    /// Adds one edge `a → b` tagged `tag`, on its own: an outline whose edges are not the
+    /// rings of one polygon each (z-fail's far outline, whose tags are weights).
+    pub(crate) fn add_edge(&mut self, tag: u32, a: DVec2, b: DVec2) {
+        let seq = self.edges.len() as u32;
+        self.edges.extend(Edge::within(tag, a, b, self.height, &self.within).map(|e| Edge { seq, ..e }));
+        self.built = false;
+    }
+
     /// The finished table of the rings of polygons `0..rings.len()` (ring `i` tagged `i`),
     /// for an image `height` lines high: the table [`EdgeTable::add_ring`] (ring by ring)
     /// and [`EdgeTable::finish`] build, sorted as it is made, with no unsorted list beside it

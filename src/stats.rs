@@ -178,6 +178,9 @@ counters! {
     ShadowPolygonsNearCap = "shadow_polygons_near_cap",
     /// Shadow volumes: the cross-sections with the far plane that closes z-fail's volumes.
     ShadowPolygonsFarCap = "shadow_polygons_far_cap",
+    /// Shadow volumes: the screen edges left of the far caps once those two casters share
+    /// cancel (z-fail's far outline, ours).
+    FarOutlineEdges = "far_outline_edges",
     /// Shadow volumes: the sides cut away where no line of sight can reach them.
     SidesOutsideSight = "sides_outside_sight",
     /// Stencil volumes: writes to the stencil buffer.

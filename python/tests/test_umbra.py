@@ -76,6 +76,9 @@ def test_stage_settings_are_keywords(scene):
     assert (default.light[0] == unfiltered.light[0]).all(), "a step of ours changes no pixel"
     zfail = umbra.render(scene, shadows="crow", counting="zfail")
     assert (zfail.light[0] == default.light[0]).mean() > 0.99
+    caps = umbra.render(scene, shadows="crow", counting="zfail", far_outline=False)
+    assert (caps.light[0] == zfail.light[0]).all(), "the far outline changes no pixel"
+    assert caps.counters.get("shadow.far_outline_edges", 0) == 0 < zfail.counters["shadow.far_outline_edges"]
     rows = umbra.bench(scene, shadows=["crow"], runs=1, warmup=0, counting="zfail")
     assert rows[0]["shadows"] == "crow"
     with pytest.raises(umbra.UmbraError) as e:

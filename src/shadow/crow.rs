@@ -26,7 +26,9 @@
 //! volume never counts for its own face.
 
 use super::volumes::{Adjacency, Counting, ScreenVolumes};
-use super::{Construction, CountAdd, Decision, Detail, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
+use super::{
+    Construction, CountAdd, Decision, Detail, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions, FAR_CAPS,
+};
 use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
@@ -37,6 +39,9 @@ use glam::DVec2;
 struct SampleVolumes {
     table: EdgeTable,
     volumes: ScreenVolumes,
+    /// Z-fail's far outline (ours, [`super::far_outline`]): its edges, each tagged with the
+    /// weight its crossing adds to the count (an `i32`'s bits); empty without it.
+    far: EdgeTable,
 }
 
 /// The prepared stage.
@@ -59,12 +64,18 @@ impl<'a> Crow<'a> {
                 // Sorted as it is made, with no unsorted list beside it (ours; z-fail puts
                 // more than two million edges into s3's table).
                 let table = EdgeTable::of_rings(view.height, &volumes.rings);
-                // The walk reads the table and the polygons' planes: the outlines are kept
+                let mut far = EdgeTable::new(view.height);
+                for e in &volumes.far {
+                    far.add_edge(e.crossing_weight() as u32, e.lo, e.hi);
+                }
+                far.finish();
+                // The walk reads the tables and the polygons' planes: the outlines are kept
                 // for a study alone (ours).
                 if !ctx.keep_outlines {
                     volumes.rings = Default::default();
+                    volumes.far = Vec::new();
                 }
-                SampleVolumes { table, volumes }
+                SampleVolumes { table, volumes, far }
             })
             .collect();
         Crow { ctx, counting, samples }
@@ -73,7 +84,7 @@ impl<'a> Crow<'a> {
 
 impl ShadowStage for Crow<'_> {
     fn bytes(&self) -> usize {
-        self.samples.iter().map(|s| s.table.bytes() + s.volumes.bytes()).sum()
+        self.samples.iter().map(|s| s.table.bytes() + s.volumes.bytes() + s.far.bytes()).sum()
     }
 
     fn walker(&self) -> Box<dyn ShadowWalker + '_> {
@@ -88,6 +99,7 @@ impl ShadowStage for Crow<'_> {
                     xs: Vec::new(),
                     cursor: 0,
                     open: OpenSet::new(s.volumes.polys.len()),
+                    far: FarLine { aet: ActiveEdges::new(&s.far, 0..h), xs: Vec::new(), cursor: 0, winding: 0 },
                 })
                 .collect(),
             events: Vec::new(),
@@ -102,11 +114,15 @@ impl ShadowStage for Crow<'_> {
         })
     }
 
+    /// The first sample's shadow polygons, then its far outline's edges, each as a ring of
+    /// two points.
     fn outlines(&self) -> Vec<Vec<DVec2>> {
         if !self.ctx.keep_outlines {
             return Vec::new();
         }
-        self.samples.first().map_or_else(Vec::new, |s| s.volumes.rings.iter().map(<[DVec2]>::to_vec).collect())
+        let Some(s) = self.samples.first() else { return Vec::new() };
+        let polys = s.volumes.rings.iter().map(<[DVec2]>::to_vec);
+        polys.chain(s.volumes.far.iter().map(|e| vec![e.lo, e.hi])).collect()
     }
 }
 
@@ -117,6 +133,36 @@ struct LineState<'a> {
     xs: Vec<(u32, u32)>,
     cursor: usize,
     open: OpenSet,
+    far: FarLine<'a>,
+}
+
+/// One sample's walk along its far outline on the current line: the crossings as (first
+/// pixel, weight), and the winding number at the pixel the walk has reached.
+struct FarLine<'a> {
+    aet: ActiveEdges<'a>,
+    xs: Vec<(u32, i32)>,
+    cursor: usize,
+    winding: i32,
+}
+
+impl FarLine<'_> {
+    /// What the far caps add along `run` (ours), onto `events`: the winding number at its
+    /// first pixel, then the weight of each crossing inside it.
+    fn events_in(&mut self, run: &Run, events: &mut Vec<(u32, i32)>) {
+        while self.cursor < self.xs.len() && self.xs[self.cursor].0 <= run.x0 {
+            self.winding += self.xs[self.cursor].1;
+            self.cursor += 1;
+        }
+        if self.winding != 0 {
+            events.push((run.x0, self.winding));
+        }
+        while self.cursor < self.xs.len() && self.xs[self.cursor].0 < run.x1 {
+            let (at, w) = self.xs[self.cursor];
+            events.push((at, w));
+            self.winding += w;
+            self.cursor += 1;
+        }
+    }
 }
 
 impl LineState<'_> {
@@ -192,7 +238,8 @@ impl Walker<'_> {
                     events.push((z, -c));
                     // Kept for traces only: a render never asks for them.
                     if record {
-                        adds.push(CountAdd { polygon: t, start: a, end: z, add: c, near_cap: p.near_cap });
+                        let near_cap = p.near_cap;
+                        adds.push(CountAdd { polygon: t, start: a, end: z, add: c, near_cap, far_caps: false });
                     }
                 }
             };
@@ -212,6 +259,27 @@ impl Walker<'_> {
             }
             add(s, m, first);
             add(m, e, last);
+        }
+    }
+
+    /// For traces: what the far caps add along `run`, from their events (`self.events[from..]`,
+    /// in order), as one [`CountAdd`] per stretch where it is constant and not zero.
+    fn record_far(&mut self, run: &Run, from: usize) {
+        let mut add = 0;
+        let mut start = run.x0;
+        for i in from..=self.events.len() {
+            let (at, change) = self.events.get(i).copied().unwrap_or((run.x1, 0));
+            if at > start && add != 0 {
+                self.last_adds.push(CountAdd {
+                    polygon: FAR_CAPS,
+                    start,
+                    end: at,
+                    add,
+                    near_cap: false,
+                    far_caps: true,
+                });
+            }
+            (add, start) = (add + change, start.max(at));
         }
     }
 
@@ -270,6 +338,11 @@ impl ShadowWalker for Walker<'_> {
             st.xs.extend(xs.iter().map(|c| (boundary(c.x, width), c.tag)));
             st.cursor = 0;
             st.open.clear();
+            let far = &mut st.far;
+            let xs = far.aet.advance_to(line);
+            far.xs.clear();
+            far.xs.extend(xs.iter().map(|c| (boundary(c.x, width), c.tag as i32)));
+            (far.cursor, far.winding) = (0, 0);
         }
     }
 
@@ -283,6 +356,11 @@ impl ShadowWalker for Walker<'_> {
         let mut pieces = std::mem::take(&mut self.last_pieces);
         self.lines[k].pieces_in(run, &mut pieces);
         self.count_events(k, run, bd, &pieces);
+        let from = self.events.len();
+        self.lines[k].far.events_in(run, &mut self.events);
+        if self.stage.ctx.keep_outlines {
+            self.record_far(run, from);
+        }
         self.last_pieces = pieces;
         self.sweep(run, lit);
     }

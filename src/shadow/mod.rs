@@ -10,6 +10,7 @@
 mod atherton_weiler_greenberg;
 mod bouknight_kelley;
 mod crow;
+mod far_outline;
 mod nishita_nakamae;
 mod overlay;
 mod planar;
@@ -235,16 +236,30 @@ pub struct VolumeOptions {
     /// z-fail's volumes are then clipped by the camera's far plane where the scene has one
     /// (the failure Everitt and Kilgard's infinite far plane removes).
     pub sight_cuts: bool,
+    /// Count z-fail's far caps as the outline of their union (default true; ours; Crow's
+    /// stage only, where the sight cuts close the volumes at a far plane): the caps' edges
+    /// that two casters share cancel, and the walk adds the winding number of what is left
+    /// instead of walking every cap (`docs/algorithms/crow.md`). `false` walks each far cap
+    /// as a shadow polygon of its own.
+    pub far_outline: bool,
 }
 
 impl VolumeOptions {
     /// Z-pass with the eye's own count, on merged volumes, cut to sight.
-    pub const DEFAULT: VolumeOptions =
-        VolumeOptions { counting: volumes::Counting::ZPass, construction: Construction::Merged, sight_cuts: true };
+    pub const DEFAULT: VolumeOptions = VolumeOptions {
+        counting: volumes::Counting::ZPass,
+        construction: Construction::Merged,
+        sight_cuts: true,
+        far_outline: true,
+    };
 
     /// Crow's 1977 construction counted by z-pass, uncut: the paper as published.
-    pub const PAPER: VolumeOptions =
-        VolumeOptions { counting: volumes::Counting::ZPass, construction: Construction::Crow1977, sight_cuts: false };
+    pub const PAPER: VolumeOptions = VolumeOptions {
+        counting: volumes::Counting::ZPass,
+        construction: Construction::Crow1977,
+        sight_cuts: false,
+        far_outline: false,
+    };
 }
 
 impl Default for VolumeOptions {
@@ -590,7 +605,13 @@ pub struct CountAdd {
     pub add: i32,
     /// A near cap: part of the eye's own count.
     pub near_cap: bool,
+    /// Z-fail's far caps, counted together as the outline of their union (their `polygon`
+    /// is [`FAR_CAPS`]; ours, `VolumeOptions::far_outline`).
+    pub far_caps: bool,
 }
+
+/// The `polygon` of a [`CountAdd`] that the far caps make together.
+pub const FAR_CAPS: u32 = u32::MAX;
 
 /// The shadow methods, each with its own settings. Chosen by name on the command line
 /// (`"crow".parse()` gives Crow with its defaults).
@@ -793,7 +814,9 @@ impl ShadowMethod {
                 out.push(ShadowMethod::BouknightKelley(BouknightKelleyOptions { solid_cull: false, ..*o }));
             }
             ShadowMethod::Crow(v) => {
-                out.push(ShadowMethod::Crow(VolumeOptions { counting: volumes::Counting::ZFail, ..*v }));
+                let z_fail = VolumeOptions { counting: volumes::Counting::ZFail, ..*v };
+                out.push(ShadowMethod::Crow(z_fail));
+                out.push(ShadowMethod::Crow(VolumeOptions { far_outline: false, ..z_fail }));
                 out.push(ShadowMethod::Crow(VolumeOptions { sight_cuts: false, ..*v }));
                 out.push(ShadowMethod::Crow(VolumeOptions { counting: volumes::Counting::NaiveZPass, ..*v }));
             }
@@ -899,6 +922,8 @@ impl ShadowMethod {
                     let construction = v.construction != Construction::Merged;
                     on.push((construction, format!("--volumes {}", v.construction.name())));
                     on.push((!v.sight_cuts, "--no-sight-cuts".into()));
+                    let crow = matches!(self, ShadowMethod::Crow(_));
+                    on.push((crow && !v.far_outline, "--no-far-outline".into()));
                 }
             }
             ShadowMethod::Williams(o) => on.extend(o.flags().into_iter().map(|f| (true, f))),

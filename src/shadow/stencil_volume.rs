@@ -52,7 +52,9 @@ impl<'a> StencilVolume<'a> {
         let lit = ctx
             .all_samples()
             .map(|(_, _, sample)| {
-                let vols = ScreenVolumes::new(ctx, &adjacency, sample, options, counters);
+                // Every shadow polygon is drawn into the stencil, the far caps too.
+                let drawn = VolumeOptions { far_outline: false, ..options };
+                let vols = ScreenVolumes::new(ctx, &adjacency, sample, drawn, counters);
                 // Each band's shadow polygons, those whose lines reach it, so that a band draws
                 // only its own (ours: a tiled rasteriser's binning; z-fail puts a million caps
                 // on s3).

@@ -47,6 +47,7 @@
 //! ([`SightHull`]), and z-fail's volumes are closed at a plane beyond the scene, with *far
 //! caps* there instead of back caps at infinity, where there is such a plane ([`FarPlane`]).
 
+use super::far_outline::{self, FarEdge};
 use super::projection::{light_side, unseen, Projector, Target};
 use super::ShadowContext;
 use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane, RingPieces, Rings};
@@ -132,15 +133,19 @@ pub struct ShadowPolygon {
 const PIECE: usize = 4096;
 
 /// The shadow polygons of one light sample for a count taken by `counting`, each put
-/// through `camera` as soon as it is made: by pieces, in order.
+/// through `camera` as soon as it is made: by pieces, in order. With `far_outline`, the far
+/// caps of the merged polygons are kept as the edges of their union instead
+/// ([`super::far_outline`]).
 fn shadow_polygons(
     ctx: &ShadowContext,
     adjacency: &Adjacency,
     sample: LightSample,
     counting: Counting,
     far: Option<&FarPlane>,
+    far_outline: bool,
     camera: &Camera,
 ) -> Vec<Piece> {
+    let far_outline = far_outline && far.is_some();
     let b = Builder::new(ctx, sample, counting, far);
     // With merged volumes, a closed solid's polygons turned away from the light are left out
     // (ours): every shadow ray crossing one has crossed, nearer the light, one of the same
@@ -175,10 +180,15 @@ fn shadow_polygons(
         |(scratch, proj), polys| {
             let mut piece = Piece::default();
             for &p in polys.iter().filter(|&&p| casts(p as usize)) {
-                for cap in b.caps(proj, ctx.scene.verts(p as usize), p as usize, None) {
-                    piece.add(camera, scratch, cap);
+                let [front, back] = b.caps(proj, ctx.scene.verts(p as usize), p as usize, None);
+                piece.add(camera, scratch, front);
+                if far_outline {
+                    piece.add_far(camera, scratch, back);
+                } else {
+                    piece.add(camera, scratch, back);
                 }
             }
+            piece.far = far_outline::cancel(std::mem::take(&mut piece.far));
             piece
         },
     );
@@ -334,6 +344,8 @@ struct Piece {
     outside: u64,
     /// Crow 1977's starting count: the volumes that hold the eye.
     eye_count: i32,
+    /// The far caps' screen edges, wound alike, for the far outline.
+    far: Vec<FarEdge>,
 }
 
 impl Piece {
@@ -348,6 +360,21 @@ impl Piece {
             }
             Screened::OutOfSight => self.outside += 1,
             Screened::Off => {}
+        }
+    }
+
+    /// Puts far cap `sp` (if one was made) through `camera` and keeps its screen edges, wound
+    /// so that its inside winds +1, for the far outline. A cap with no area about the far
+    /// plane's normal (which the projection never gives) is kept as a polygon.
+    fn add_far(&mut self, camera: &Camera, scratch: &mut Scratch, sp: Option<ShadowPolygon>) {
+        let Some(sp) = sp else { return };
+        let winding = sp.plane.map_or(0, |f| far_outline::screen_winding(camera.view, &sp.verts, f.n, f.d));
+        if winding == 0 {
+            return self.add(camera, scratch, Some(sp));
+        }
+        self.made[sp.part as usize] += 1;
+        if let Screened::On(_) = scratch.screen(camera, &sp) {
+            far_outline::push_ring(&scratch.ring, winding, &mut self.far);
         }
     }
 }
@@ -965,12 +992,15 @@ pub struct ScreenVolumes {
     pub polys: Vec<ScreenShadowPolygon>,
     /// Their screen outlines, parallel to `polys`, in the pieces that made them.
     pub rings: RingPieces,
+    /// The far caps' outline (z-fail's far outline, ours): the edges left once those two
+    /// caps share cancel, each with its weight; empty without it.
+    pub(crate) far: Vec<FarEdge>,
 }
 
 impl ScreenVolumes {
     /// The bytes it holds: the polygons and their outlines.
     pub(crate) fn bytes(&self) -> usize {
-        crate::pool::held(&self.polys) + self.rings.bytes()
+        crate::pool::held(&self.polys) + self.rings.bytes() + crate::pool::held(&self.far)
     }
 
     /// The shadow polygons of `sample` built and counted as `options` say, put through the
@@ -1001,7 +1031,7 @@ impl ScreenVolumes {
         let camera = Camera { view, hull, far_clip };
         let pieces = match options.construction {
             super::Construction::Crow1977 => crow_1977(ctx, adjacency, sample, counting, &camera),
-            _ => shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), &camera),
+            _ => shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), options.far_outline, &camera),
         };
         let eye_count = pieces.iter().map(|p| p.eye_count).sum::<i32>();
         if options.construction == super::Construction::Crow1977 && counting == Counting::ZPass {
@@ -1026,17 +1056,20 @@ impl ScreenVolumes {
         let outside = sum(&|p| p.outside);
         let out = ScreenVolumes::joined(pieces);
         counters.add(crate::stats::Counter::ScreenShadowPolygons, out.polys.len() as u64);
+        counters.add(crate::stats::Counter::FarOutlineEdges, out.far.len() as u64);
         counters.add(crate::stats::Counter::SidesOutsideSight, outside);
         out
     }
 
     /// The pieces' polygons in one list, in order (each piece copies its own into its
-    /// stretch, in parallel); their outlines stay in their pieces.
-    fn joined(pieces: Vec<Piece>) -> ScreenVolumes {
+    /// stretch, in parallel); their outlines stay in their pieces. The far edges the pieces
+    /// left are cancelled once more, across the pieces.
+    fn joined(mut pieces: Vec<Piece>) -> ScreenVolumes {
+        let far = far_outline::cancel(pieces.iter_mut().flat_map(|p| std::mem::take(&mut p.far)).collect());
         let polys: Vec<&[ScreenShadowPolygon]> = pieces.iter().map(|p| p.polys.as_slice()).collect();
         let polys = joined(&polys, |_, &p| p);
         let rings = RingPieces::new(pieces.into_iter().map(|p| p.rings).collect());
-        ScreenVolumes { polys, rings }
+        ScreenVolumes { polys, rings, far }
     }
 }
 

@@ -840,6 +840,52 @@ fn zfail_closes_its_volumes_at_a_far_plane_or_at_infinity() {
     }
 }
 
+/// Z-fail's far outline (ours): counting the far caps as the outline of their union gives
+/// the count that walking each far cap gave, pixel for pixel, on closed solids lit from
+/// outside (where only the far ends of the silhouette's sides are left, one per side), on
+/// open meshes, a light inside a closed box, and a light at a cube's corner; the stencil
+/// stage, which draws its caps, is not touched by the switch.
+#[test]
+fn the_far_outline_counts_what_the_far_caps_counted() {
+    use umbra::shadow::{Counting, VolumeOptions};
+    use umbra::Counter;
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let load = |f: &str| Scene::load(dir.join(f)).unwrap();
+    let spheres = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
+    let scenes = [
+        ("spheres", spheres),
+        ("cornell", load_scaled(&"scenes/cornell.toml".into(), 200)),
+        ("box", load("tests/data/robustness/crow_light_inside_closed_box.toml")),
+        ("corner", load("tests/data/robustness/crow_light_at_cube_vertex.toml")),
+    ];
+    for (name, scene) in &scenes {
+        let frame = |far_outline| {
+            let v = VolumeOptions { counting: Counting::ZFail, far_outline, ..VolumeOptions::default() };
+            umbra::render(scene, &umbra::RenderOptions { shadows: ShadowMethod::Crow(v), ..Default::default() })
+                .unwrap()
+        };
+        let (outline, caps) = (frame(true), frame(false));
+        assert_eq!(outline.frame.light, caps.frame.light, "{name}: the counts differ");
+        let (a, b) = (&outline.stats.shadow_counters, &caps.stats.shadow_counters);
+        let far_caps = a.get(Counter::ShadowPolygonsFarCap);
+        assert_eq!(far_caps, b.get(Counter::ShadowPolygonsFarCap), "{name}: the same caps are made");
+        assert_eq!(b.get(Counter::FarOutlineEdges), 0, "{name}: no outline without the switch");
+        let polygons = |c: &umbra::Counters| c.get(Counter::ScreenShadowPolygons);
+        assert!(polygons(a) < polygons(b), "{name}: the far caps are no polygons of their own");
+        if *name == "spheres" {
+            // Closed solids lit from outside: the outline is the far end of every side.
+            assert!(far_caps > 1000, "{far_caps}");
+            assert_eq!(a.get(Counter::FarOutlineEdges), a.get(Counter::ShadowPolygonsSide));
+        }
+    }
+    let stencil = |far_outline| {
+        let v = VolumeOptions { counting: Counting::ZFail, far_outline, ..VolumeOptions::default() };
+        let opts = umbra::RenderOptions { shadows: ShadowMethod::StencilVolume(v), ..Default::default() };
+        umbra::render(&scenes[0].1, &opts).unwrap().frame.light
+    };
+    assert_eq!(stencil(true), stencil(false));
+}
+
 /// Seed 000's umbra and penumbra of an area light: `umbra<k>.png` exists for the area light
 /// only, reads 0 where no sample lights the point, 255 where all do and 128 between, and
 /// the counters count the same pixels (`scenes/lights.toml`: light 3 is a 4×4 area light).

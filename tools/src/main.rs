@@ -277,6 +277,10 @@ struct ShadowArgs {
     /// cut to where a count reaches, z-fail closed beyond the scene).
     #[arg(long)]
     no_sight_cuts: bool,
+    /// Crow with z-fail: walk each far cap as a shadow polygon of its own (ours: the far
+    /// caps counted as the outline of their union).
+    #[arg(long)]
+    no_far_outline: bool,
     /// Williams: texels along each side of a shadow map.
     #[arg(long, default_value_t = 2048)]
     map_size: u32,
@@ -374,7 +378,12 @@ impl ShadowArgs {
                 solid_cull: !self.no_solid_cull,
             },
             atherton_weiler_greenberg: self.awg.options(!self.no_solid_cull),
-            volumes: VolumeOptions { counting: self.crow_count, construction, sight_cuts: !self.no_sight_cuts },
+            volumes: VolumeOptions {
+                counting: self.crow_count,
+                construction,
+                sight_cuts: !self.no_sight_cuts,
+                far_outline: !self.no_far_outline,
+            },
             williams: WilliamsOptions {
                 map_size: self.map_size,
                 bias: self.bias,

@@ -394,9 +394,9 @@ function drawStage(t) {
     }
   } else if (detail.kind === "counts") {
     for (const a of detail.adds) {
-      name(row, `#${a.polygon}`);
+      name(row, a.far_caps ? "far" : `#${a.polygon}`);
       bar(a.start, a.end, row++, a.add > 0 ? "rgba(200, 60, 60, 0.6)" : "rgba(60, 120, 200, 0.6)",
-        `${a.add > 0 ? "+" : ""}${a.add}${a.near_cap ? " (eye)" : ""}`);
+        `${a.add > 0 ? "+" : ""}${a.add}${a.near_cap ? " (eye)" : ""}${a.far_caps ? " (far caps)" : ""}`);
     }
     name(row, "count");
     for (const [a, b, n] of detail.counts) bar(a, b, row, n === 0 ? "rgba(250, 200, 40, 0.9)" : "#243a73", `${n}`);
