@@ -297,23 +297,29 @@ impl View {
         self.clip_project_to(verts, self.far, scratch, out)
     }
 
+    /// Camera coordinates of a homogeneous world point (`w` kept).
+    #[inline]
+    pub(crate) fn homogeneous_in_camera(&self, h: DVec4) -> DVec4 {
+        let v = h.truncate() - self.eye * h.w;
+        DVec4::new(v.dot(self.r), v.dot(self.u), v.dot(self.f), h.w)
+    }
+
     /// Clips a polygon given in homogeneous world coordinates (`w = 0` for points at infinity,
     /// as shadow volumes extruded to infinity have) to the near plane and to a guard band
     /// 10⁴ times wider than the view, then projects it. The guard band keeps every point in
     /// front of the eye, so vanishing points project to finite (far off-screen) positions.
+    /// `None` when nothing is left; else whether the outline is the polygon's corners, each
+    /// by [`Self::homogeneous_in_camera`] and [`Self::project`], uncut.
     pub(crate) fn clip_project_homogeneous(
         &self,
         verts: &[DVec4],
         scratch: &mut [Vec<DVec4>; 2],
         out: &mut Vec<DVec2>,
-    ) -> bool {
+    ) -> Option<bool> {
         out.clear();
         let [a, b] = scratch;
         a.clear();
-        a.extend(verts.iter().map(|h| {
-            let v = h.truncate() - self.eye * h.w;
-            DVec4::new(v.dot(self.r), v.dot(self.u), v.dot(self.f), h.w)
-        }));
+        a.extend(verts.iter().map(|&h| self.homogeneous_in_camera(h)));
         let g = 1e4 * (self.t * self.aspect).max(self.t);
         let near = self.near;
         let planes: [&dyn Fn(DVec4) -> f64; 5] = [
@@ -323,14 +329,15 @@ impl View {
             &|c: DVec4| g * c.z - c.y,
             &|c: DVec4| g * c.z + c.y,
         ];
+        let mut whole = true;
         for plane in planes {
-            clip_in_place(a, b, plane);
+            whole &= !clip_in_place(a, b, plane);
         }
         if a.len() < 3 {
-            return false;
+            return None;
         }
         out.extend(a.iter().map(|c| self.project(c.truncate())));
-        out.iter().all(|p| p.is_finite())
+        out.iter().all(|p| p.is_finite()).then_some(whole)
     }
 
     /// The near plane (normal along the view direction) and the corners of the part of it

@@ -139,15 +139,17 @@ pub fn classify_face(verts: &[DVec3]) -> FaceShape {
 
 /// Keeps the part of polygon `a` where `dist >= 0`, in place (`b` is scratch): the
 /// Sutherland-Hodgman step every clip by a half-space takes, skipped when no vertex is
-/// outside.
-pub(crate) fn clip_in_place<T>(a: &mut Vec<T>, b: &mut Vec<T>, dist: impl Fn(T) -> f64)
+/// outside. Whether it cut anything.
+pub(crate) fn clip_in_place<T>(a: &mut Vec<T>, b: &mut Vec<T>, dist: impl Fn(T) -> f64) -> bool
 where
     T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Mul<f64, Output = T>,
 {
-    if a.iter().any(|&x| dist(x) < 0.0) {
+    let cut = a.iter().any(|&x| dist(x) < 0.0);
+    if cut {
         clip_polygon(a, dist, b);
         std::mem::swap(a, b);
     }
+    cut
 }
 /// Clips a polygon (convex or not) to the half-space `dist(p) >= 0` (Sutherland-Hodgman),
 /// in 3D or, with `DVec4`, in homogeneous coordinates. A concave polygon may come back with

@@ -14,12 +14,15 @@
 //! 1. **Wound alike.** Each far cap is put on screen as before, and its edges are kept wound
 //!    so that its inside has winding number +1 ([`screen_winding`], from its normal in the
 //!    world, never from its screen area, which rounding can turn for a sliver).
-//! 2. **Cancelled.** Edges are keyed by their end points' bits, the lesser first, and sorted;
-//!    the ways they run are summed and the edges that come to zero dropped
-//!    ([`cancel`]): per piece of polygons as it is made, then over the pieces. Only end
-//!    points with the same bits cancel, which the projection gives a corner two caps share
-//!    (it is worked out from the corner alone); an edge that finds no partner stays and
-//!    still counts right.
+//! 2. **Cancelled.** A cap *whole* on screen (nothing of it cut, by the projection's clips
+//!    or the camera's) is its corners' images, each worked out from the corner alone
+//!    (`Target::onto`, then the camera), so the caps on one edge of the scene give its
+//!    image the same bits. Such a cap leaves only the way it winds, and a pass over the
+//!    merged edges (`volumes::Adjacency`) sums, on each, the ways its whole caps run it:
+//!    an edge run as often each way is left out, any other is kept with its count (on a
+//!    closed mesh, the far end of a side). A cap that was cut leaves its own edges. Last,
+//!    edges with the same end points' bits are summed and those that come to zero dropped
+//!    ([`cancel`]); an edge that finds no partner stays and still counts right.
 //! 3. **Walked.** The edges left go into an edge table of their own, each tagged with the
 //!    weight its crossing adds ([`FarEdge::crossing_weight`]); the count at a pixel adds the
 //!    weights of the crossings at or left of its centre. A cap edge's crossings are those
@@ -51,6 +54,12 @@ impl FarEdge {
         } else {
             FarEdge { lo: b, hi: a, w: -1 }
         }
+    }
+
+    /// The edge `a → b` run `n` times (negative: the other way).
+    pub(crate) fn run(a: DVec2, b: DVec2, n: i32) -> FarEdge {
+        let e = FarEdge::new(a, b);
+        FarEdge { w: e.w * n, ..e }
     }
 
     /// What crossing it adds to the winding number of a point right of the crossing: an

@@ -83,6 +83,17 @@ impl Target {
         Target { plane, rect, sample, side: light_side(&plane, sample), pyramid }
     }
 
+    /// Point `x` projected from the light onto the plane (`x` between the light and the
+    /// plane).
+    #[inline]
+    pub fn onto(&self, x: DVec3) -> DVec3 {
+        let plane = &self.plane;
+        match self.sample {
+            LightSample::Point(s) => s + (x - s) * (-plane.distance(s) / plane.n.dot(x - s)),
+            LightSample::Directional(d) => x - d * (plane.distance(x) / plane.n.dot(d)),
+        }
+    }
+
     /// Whether polygon `verts` lies wholly outside one face of the pyramid: then
     /// [`Projector::project`] would find nothing, and need not be asked.
     pub fn misses(&self, verts: &[DVec3]) -> bool {
@@ -96,6 +107,9 @@ impl Target {
 pub struct Projector {
     /// The last shadow made, in world space.
     pub shadow: Vec<DVec3>,
+    /// Whether the last shadow was cut by a clip: else it is the polygon's corners, each
+    /// projected by [`Target::onto`].
+    pub clipped: bool,
     scratch: Vec<DVec3>,
 }
 
@@ -108,6 +122,7 @@ impl Projector {
     /// is left or the shadow has no area.
     pub fn project(&mut self, verts: &[DVec3], target: &Target) -> bool {
         let (plane, side) = (&target.plane, target.side);
+        self.clipped = false;
         self.shadow.clear();
         self.shadow.extend_from_slice(verts);
         self.clip(|x| plane.distance(x) * side);
@@ -122,10 +137,7 @@ impl Projector {
             return false;
         }
         for x in &mut self.shadow {
-            *x = match target.sample {
-                LightSample::Point(s) => s + (*x - s) * (-plane.distance(s) / plane.n.dot(*x - s)),
-                LightSample::Directional(d) => *x - d * (plane.distance(*x) / plane.n.dot(d)),
-            };
+            *x = target.onto(*x);
         }
         let area2 = newell_normal(&self.shadow).length();
         let size = target.rect[0].distance(target.rect[2]);
@@ -136,6 +148,7 @@ impl Projector {
         if !self.shadow.is_empty() && self.shadow.iter().any(|&x| dist(x) < 0.0) {
             clip_polygon(&self.shadow, dist, &mut self.scratch);
             std::mem::swap(&mut self.shadow, &mut self.scratch);
+            self.clipped = true;
         }
     }
 }

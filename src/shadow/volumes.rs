@@ -58,6 +58,7 @@ use crate::stats::Counters;
 use crate::view::DepthPlane;
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicI8, Ordering};
 use std::sync::Arc;
 
 /// How a count is taken along the line of sight.
@@ -174,7 +175,11 @@ fn shadow_polygons(
             piece
         })
         .collect();
-    // Step 2: the caps of every merged polygon.
+    // Step 2: the caps of every merged polygon. For the far outline, a far cap whose outline
+    // on screen is its corners' images, uncut, leaves only the way it winds (`wound`) for
+    // step 2b; any other far cap leaves its edges.
+    let wound: Vec<AtomicI8> =
+        (0..if far_outline { ctx.scene.polygons.len() } else { 0 }).map(|_| AtomicI8::new(0)).collect();
     let caps = adjacency.merged.par_chunks(PIECE).map_init(
         || (Scratch::default(), Projector::default()),
         |(scratch, proj), polys| {
@@ -182,17 +187,35 @@ fn shadow_polygons(
             for &p in polys.iter().filter(|&&p| casts(p as usize)) {
                 let [front, back] = b.caps(proj, ctx.scene.verts(p as usize), p as usize, None);
                 piece.add(camera, scratch, front);
-                if far_outline {
-                    piece.add_far(camera, scratch, back);
-                } else {
+                if !far_outline {
                     piece.add(camera, scratch, back);
+                } else if let Some(w) = piece.add_far(camera, scratch, back, !proj.clipped) {
+                    wound[p as usize].store(w, Ordering::Relaxed);
                 }
             }
-            piece.far = far_outline::cancel(std::mem::take(&mut piece.far));
             piece
         },
     );
     pieces.par_extend(caps);
+    // Step 2b, the far outline's edges of the whole far caps: the two caps on an edge of a
+    // closed mesh run its image once each way and leave nothing; an edge they run more one
+    // way than the other is kept, run that many times (the far end of a side).
+    if let (Some(far), true) = (&b.far, far_outline) {
+        let edges = adjacency.edge_pieces().map(|edges| {
+            let mut piece = Piece::default();
+            for (e, sharing) in edges {
+                let way =
+                    |s: &Sharing| i32::from(wound[s.poly()].load(Ordering::Relaxed)) * if s.forward() { 1 } else { -1 };
+                let runs: i32 = sharing.iter().map(way).sum();
+                if runs != 0 {
+                    let (ea, eb) = e.ends(ctx.scene);
+                    piece.far.push(FarEdge::run(b.far_image(far, ea), b.far_image(far, eb), runs));
+                }
+            }
+            piece
+        });
+        pieces.par_extend(edges);
+    }
     // Step 3: the volumes kept apart, each with its own sides and caps.
     let (mut piece, mut scratch, mut proj) = (Piece::default(), Scratch::default(), Projector::default());
     for apart in adjacency.apart.iter().filter(|apart| casts(apart.poly as usize)) {
@@ -363,19 +386,32 @@ impl Piece {
         }
     }
 
-    /// Puts far cap `sp` (if one was made) through `camera` and keeps its screen edges, wound
-    /// so that its inside winds +1, for the far outline. A cap with no area about the far
-    /// plane's normal (which the projection never gives) is kept as a polygon.
-    fn add_far(&mut self, camera: &Camera, scratch: &mut Scratch, sp: Option<ShadowPolygon>) {
-        let Some(sp) = sp else { return };
+    /// Puts far cap `sp` (if one was made; `projected_whole`: its corners' projections,
+    /// uncut) through `camera`, for the far outline. A cap whole on screen too gives the way
+    /// it winds (+1: counter-clockwise), and its edges are left to the edges' pass; any other
+    /// keeps its screen edges here, wound so that its inside winds +1. A cap with no area
+    /// about the far plane's normal (which the projection never gives) is kept as a polygon.
+    fn add_far(
+        &mut self,
+        camera: &Camera,
+        scratch: &mut Scratch,
+        sp: Option<ShadowPolygon>,
+        projected_whole: bool,
+    ) -> Option<i8> {
+        let sp = sp?;
         let winding = sp.plane.map_or(0, |f| far_outline::screen_winding(camera.view, &sp.verts, f.n, f.d));
         if winding == 0 {
-            return self.add(camera, scratch, Some(sp));
+            self.add(camera, scratch, Some(sp));
+            return None;
         }
         self.made[sp.part as usize] += 1;
         if let Screened::On(_) = scratch.screen(camera, &sp) {
+            if projected_whole && scratch.whole && scratch.ring.len() == sp.verts.len() {
+                return Some(winding as i8);
+            }
             far_outline::push_ring(&scratch.ring, winding, &mut self.far);
         }
+        None
     }
 }
 
@@ -396,6 +432,14 @@ impl<'c> Builder<'c> {
         let (plane, rect) = ctx.view.near_rectangle();
         let far = far.map(|f| Target::new(f.plane, f.rect, sample));
         Builder { ctx, sample, counting, near: Target::new(plane, rect, sample), far }
+    }
+
+    /// Corner `v`'s image on screen as a far cap whole on screen has it: projected from the
+    /// light onto the far plane `far`, then put through the camera (the same steps, so the
+    /// same bits).
+    fn far_image(&self, far: &Target, v: DVec3) -> DVec2 {
+        let view = self.ctx.view;
+        view.project(view.homogeneous_in_camera(finite(far.onto(v))).truncate())
     }
 
     /// The normal of the plane through edge `a → b` and the light (not normalised; zero when
@@ -1101,6 +1145,9 @@ struct Scratch {
     clip: [Vec<DVec4>; 2],
     /// The outline of the polygon last put on screen.
     ring: Vec<DVec2>,
+    /// Whether that outline is the polygon's corners, each put on screen alone (nothing was
+    /// cut).
+    whole: bool,
 }
 
 impl Scratch {
@@ -1143,8 +1190,12 @@ impl Scratch {
             // would let rounding throw it away).
             self.ring.clear();
             self.ring.extend(sp.verts.iter().map(|&v| view.project(view.to_camera(v.truncate()))));
-        } else if !view.clip_project_homogeneous(verts, &mut self.clip, &mut self.ring) {
-            return Screened::Off;
+            self.whole = false;
+        } else {
+            match view.clip_project_homogeneous(verts, &mut self.clip, &mut self.ring) {
+                Some(whole) => self.whole = whole && !cut,
+                None => return Screened::Off,
+            }
         }
         let poly = ScreenShadowPolygon {
             depth,
