@@ -64,11 +64,7 @@ impl<'a> Crow<'a> {
                 // Sorted as it is made, with no unsorted list beside it (ours; z-fail puts
                 // more than two million edges into s3's table).
                 let table = EdgeTable::of_rings(view.height, &volumes.rings);
-                let mut far = EdgeTable::new(view.height);
-                for e in &volumes.far {
-                    far.add_edge(e.crossing_weight() as u32, e.lo, e.hi);
-                }
-                far.finish();
+                let far = super::far_outline::table(view.height, &volumes.far);
                 // The walk reads the tables and the polygons' planes: the outlines are kept
                 // for a study alone (ours).
                 if !ctx.keep_outlines {

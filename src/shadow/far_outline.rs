@@ -33,6 +33,7 @@
 //! The caps of volumes kept apart (fan pieces, self-intersecting polygons) stay shadow
 //! polygons of their own: a kept-apart volume never counts on its own face.
 
+use crate::scan::EdgeTable;
 use crate::view::View;
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
@@ -72,6 +73,17 @@ impl FarEdge {
             -self.w
         }
     }
+}
+
+/// Step 3's edge table of `edges`, for an image `height` lines high: each edge tagged with
+/// its crossing's weight (an `i32`'s bits).
+pub(crate) fn table(height: u32, edges: &[FarEdge]) -> EdgeTable {
+    let mut table = EdgeTable::new(height);
+    for e in edges {
+        table.add_edge(e.crossing_weight() as u32, e.lo, e.hi);
+    }
+    table.finish();
+    table
 }
 
 /// A point's key: its bits, `x` first.

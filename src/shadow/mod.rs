@@ -236,11 +236,11 @@ pub struct VolumeOptions {
     /// z-fail's volumes are then clipped by the camera's far plane where the scene has one
     /// (the failure Everitt and Kilgard's infinite far plane removes).
     pub sight_cuts: bool,
-    /// Count z-fail's far caps as the outline of their union (default true; ours; Crow's
-    /// stage only, where the sight cuts close the volumes at a far plane): the caps' edges
-    /// that two casters share cancel, and the walk adds the winding number of what is left
-    /// instead of walking every cap (`docs/algorithms/crow.md`). `false` walks each far cap
-    /// as a shadow polygon of its own.
+    /// Count z-fail's far caps as the outline of their union (default true; ours; where the
+    /// sight cuts close the volumes at a far plane): the caps' edges that two casters share
+    /// cancel, and Crow's walk (or the stencil's drawing) adds the winding number of what is
+    /// left instead of each cap (`docs/algorithms/crow.md`). `false` counts each far cap as a
+    /// shadow polygon of its own.
     pub far_outline: bool,
 }
 
@@ -821,7 +821,9 @@ impl ShadowMethod {
                 out.push(ShadowMethod::Crow(VolumeOptions { counting: volumes::Counting::NaiveZPass, ..*v }));
             }
             ShadowMethod::StencilVolume(v) => {
-                out.push(ShadowMethod::StencilVolume(VolumeOptions { counting: volumes::Counting::ZFail, ..*v }));
+                let z_fail = VolumeOptions { counting: volumes::Counting::ZFail, ..*v };
+                out.push(ShadowMethod::StencilVolume(z_fail));
+                out.push(ShadowMethod::StencilVolume(VolumeOptions { far_outline: false, ..z_fail }));
             }
             ShadowMethod::NishitaNakamae(o) => {
                 // Each step that buys speed off by itself (the premise's fallback is what
@@ -922,8 +924,7 @@ impl ShadowMethod {
                     let construction = v.construction != Construction::Merged;
                     on.push((construction, format!("--volumes {}", v.construction.name())));
                     on.push((!v.sight_cuts, "--no-sight-cuts".into()));
-                    let crow = matches!(self, ShadowMethod::Crow(_));
-                    on.push((crow && !v.far_outline, "--no-far-outline".into()));
+                    on.push((!v.far_outline, "--no-far-outline".into()));
                 }
             }
             ShadowMethod::Williams(o) => on.extend(o.flags().into_iter().map(|f| (true, f))),

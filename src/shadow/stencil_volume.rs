@@ -5,10 +5,11 @@
 //! front of the visible surface, z-fail subtracts it where it lies behind. A pixel is in
 //! shadow where its count is above zero.
 
+use super::far_outline;
 use super::volumes::{Adjacency, ScreenVolumes};
 use super::{Construction, Decision, ShadowContext, ShadowStage, ShadowWalker, VolumeOptions};
 use crate::geometry::RingList;
-use crate::scan::{for_each_span, ring_bins, EdgeTable};
+use crate::scan::{boundary, for_each_span, ring_bins, ActiveEdges, EdgeTable};
 use crate::stats::Counters;
 use crate::view::DepthPlane;
 use crate::visibility::Run;
@@ -52,9 +53,8 @@ impl<'a> StencilVolume<'a> {
         let lit = ctx
             .all_samples()
             .map(|(_, _, sample)| {
-                // Every shadow polygon is drawn into the stencil, the far caps too.
-                let drawn = VolumeOptions { far_outline: false, ..options };
-                let vols = ScreenVolumes::new(ctx, &adjacency, sample, drawn, counters);
+                let vols = ScreenVolumes::new(ctx, &adjacency, sample, options, counters);
+                let far = far_outline::table(h, &vols.far);
                 // Each band's shadow polygons, those whose lines reach it, so that a band draws
                 // only its own (ours: a tiled rasteriser's binning; z-fail puts a million caps
                 // on s3).
@@ -89,6 +89,26 @@ impl<'a> StencilVolume<'a> {
                                     n += (c != 0) as u64;
                                 }
                             });
+                        }
+                        // The far caps together (ours, the far outline): each pixel where a
+                        // polygon is seen adds the winding number of their outline.
+                        let mut walk = ActiveEdges::new(&far, lines.clone());
+                        while let Some((y, xs)) = walk.next_line() {
+                            let row = (y - y0) as usize * w;
+                            let (mut winding, mut from) = (0i32, 0usize);
+                            for c in xs {
+                                let at = boundary(c.x, view.width) as usize;
+                                if winding != 0 {
+                                    for x in from..at {
+                                        let poly = surface[y as usize * w + x] as usize;
+                                        if planes.get(poly).is_some_and(Option::is_some) {
+                                            rows[row + x] += winding;
+                                            n += 1;
+                                        }
+                                    }
+                                }
+                                (winding, from) = (winding + c.tag as i32, at);
+                            }
                         }
                         n
                     })

@@ -277,8 +277,8 @@ struct ShadowArgs {
     /// cut to where a count reaches, z-fail closed beyond the scene).
     #[arg(long)]
     no_sight_cuts: bool,
-    /// Crow with z-fail: walk each far cap as a shadow polygon of its own (ours: the far
-    /// caps counted as the outline of their union).
+    /// Crow and stencil-volume with z-fail: count each far cap as a shadow polygon of its
+    /// own (ours: the far caps counted as the outline of their union).
     #[arg(long)]
     no_far_outline: bool,
     /// Williams: texels along each side of a shadow map.
