@@ -17,7 +17,9 @@
 //!   the eye's own count — the near caps put that in, pixel by pixel, as polygons at the near
 //!   plane that every visible point lies behind.
 //! - **z-fail**: the shadow polygons behind the visible point, signs reversed (counting from
-//!   infinity toward the eye), with the volumes capped.
+//!   infinity toward the eye), with the volumes capped. Where a far plane closes them, the
+//!   far caps count together, as the winding number of their union's outline, walked from an
+//!   edge table of its own ([`super::far_outline`], ours).
 //! - **naive z-pass**: z-pass from zero. Wrong wherever the near plane is inside a volume
 //!   (the "Rendering 6: Shadow" notes' failure), on purpose.
 //!
