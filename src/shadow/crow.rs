@@ -365,10 +365,17 @@ impl ShadowWalker for Walker<'_> {
 
     fn decision(&self) -> Decision {
         let counts: Vec<String> = self.last_counts.iter().map(|(a, b, c)| format!("{a}..{b}: {c}")).collect();
+        let far: Vec<String> = self
+            .last_adds
+            .iter()
+            .filter(|a| a.far_caps)
+            .map(|a| format!("{}..{}: {}", a.start, a.end, a.add))
+            .collect();
+        let far = if far.is_empty() { String::new() } else { format!("; the far caps add [{}]", far.join(", ")) };
         Decision {
             tested: self.last_pieces.iter().map(|&(_, s, e)| (s, e, 1)).collect(),
             note: format!(
-                "{} shadow polygon piece(s) cover the run, {} event(s); counts [{}]",
+                "{} shadow polygon piece(s) cover the run, {} event(s){far}; counts [{}]",
                 self.last_pieces.len(),
                 self.events.len(),
                 counts.join(", ")

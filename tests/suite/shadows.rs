@@ -894,6 +894,31 @@ fn the_far_outline_counts_what_the_far_caps_counted() {
     }
 }
 
+/// A trace of Crow's z-fail shows what the far caps add, together, as rows of their own
+/// (`CountAdd::far_caps`), and every run's count is the sum of what its rows add there.
+#[test]
+fn a_trace_shows_the_far_caps_together() {
+    use umbra::shadow::{Counting, Detail, VolumeOptions, FAR_CAPS};
+    let scene = umbra::generate::spheres(3000, 5, 200, 120).unwrap();
+    let crow = ShadowMethod::Crow(VolumeOptions { counting: Counting::ZFail, ..VolumeOptions::default() });
+    let (mut far_rows, mut runs) = (0, 0);
+    umbra::study::trace::trace_lines(&scene, 0..120, &crow, |t| {
+        for d in t.decisions.iter().filter(|d| d.asked_stage) {
+            let Detail::Counts { adds, counts } = &d.decision.detail else { panic!("{:?}", d.decision.detail) };
+            far_rows += adds.iter().filter(|a| a.far_caps).count();
+            assert!(adds.iter().all(|a| a.far_caps == (a.polygon == FAR_CAPS)));
+            for &(start, end, count) in counts {
+                let summed: i32 = adds.iter().filter(|a| a.start <= start && start < a.end).map(|a| a.add).sum();
+                assert_eq!(summed, count, "line {} run {}..{} at {start}..{end}", t.line, d.x0, d.x1);
+            }
+            runs += 1;
+        }
+        Ok(())
+    })
+    .unwrap();
+    assert!(runs > 100 && far_rows > 10, "{runs} runs, {far_rows} far rows");
+}
+
 /// Seed 000's umbra and penumbra of an area light: `umbra<k>.png` exists for the area light
 /// only, reads 0 where no sample lights the point, 255 where all do and 128 between, and
 /// the counters count the same pixels (`scenes/lights.toml`: light 3 is a 4×4 area light).
