@@ -39,7 +39,8 @@ use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
 
 /// A screen edge between `lo` and `hi` (ordered by their bits, [`key`]), run `w` times from
-/// `lo` to `hi` (negative: from `hi` to `lo`), its caps' insides on its left.
+/// `lo` to `hi` (negative: from `hi` to `lo`) by caps wound counter-clockwise (positive
+/// shoelace area in screen coordinates).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct FarEdge {
     pub(crate) lo: DVec2,
