@@ -443,7 +443,7 @@ struct RenderArgs {
     no_back_face_cull: bool,
     #[command(flatten)]
     shadow: ShadowArgs,
-    /// Write the analysis buffers id.png and light<k>.png into this folder, with per-pixel
+    /// Write the analysis buffers `id.png` and `light<k>.png` into this folder, with per-pixel
     /// counters in false colour: depth_complexity.png, span_splits.png, shadow_tests.png.
     #[arg(long, value_name = "DIR")]
     aov: Option<PathBuf>,
