@@ -33,9 +33,10 @@
 //! The caps of volumes kept apart (fan pieces, self-intersecting polygons) stay shadow
 //! polygons of their own: a kept-apart volume never counts on its own face.
 
+use crate::geometry::Plane;
 use crate::scan::EdgeTable;
 use crate::view::View;
-use glam::{DVec2, DVec3, DVec4};
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 /// A screen edge between `lo` and `hi` (ordered by their bits, [`key`]), run `w` times from
@@ -107,48 +108,32 @@ pub(crate) fn cancel(mut edges: Vec<FarEdge>) -> Vec<FarEdge> {
     } else {
         edges.sort_unstable_by_key(by_ends);
     }
-    let mut kept = 0;
-    for i in 0..edges.len() {
-        let e = edges[i];
-        if kept > 0 && by_ends(&edges[kept - 1]) == by_ends(&e) {
-            edges[kept - 1].w += e.w;
-        } else {
-            if kept > 0 && edges[kept - 1].w == 0 {
-                kept -= 1;
-            }
-            edges[kept] = e;
-            kept += 1;
+    edges.dedup_by(|e, kept| {
+        let same = by_ends(e) == by_ends(kept);
+        if same {
+            kept.w += e.w;
         }
-    }
-    if kept > 0 && edges[kept - 1].w == 0 {
-        kept -= 1;
-    }
-    edges.truncate(kept);
+        same
+    });
+    edges.retain(|e| e.w != 0);
     edges.shrink_to_fit();
     edges
 }
 
 /// Step 1: which way a far cap winds on screen, +1 counter-clockwise (positive shoelace
-/// area), from its corners `verts` in the world on the plane of normal `n` (and offset `d`):
-/// the sign of its area about `n`, times `view`'s side of the plane, times the handedness of
-/// the camera's axes. The perspective projection gives a small patch at camera point `c`
+/// area), from its Newell normal in the world (`newell`) on `plane`: the sign of its area
+/// about the plane's normal, times `view`'s side of the plane, times the handedness of the
+/// camera's axes. The perspective projection gives a small patch at camera point `c`
 /// with normal `N` the orientation of `N · c` in `(x/z, y/z)`, and the screen's `y` runs
 /// down; `N · c` has the sign of the area about `n` times minus the eye's side, for every
-/// point of the plane. Zero for a cap with no area about `n`.
-pub(crate) fn screen_winding(view: &View, verts: &[DVec4], n: DVec3, d: f64) -> i32 {
-    let mut area = 0.0;
-    for (i, a) in verts.iter().enumerate() {
-        let b = verts[(i + 1) % verts.len()];
-        area += (a.y - b.y) * (a.z + b.z) * n.x + (a.z - b.z) * (a.x + b.x) * n.y + (a.x - b.x) * (a.y + b.y) * n.z;
-    }
-    let eye_side = n.dot(view.eye) + d;
-    let handedness = view.r.dot(view.u.cross(view.f));
-    let s = area.signum() * eye_side.signum() * handedness.signum();
+/// point of the plane. Zero for a cap with no area about the normal.
+pub(crate) fn screen_winding(view: &View, newell: DVec3, plane: &Plane) -> i32 {
+    let (area, eye_side) = (newell.dot(plane.n), plane.distance(view.eye));
     if area == 0.0 || eye_side == 0.0 {
-        0
-    } else {
-        s as i32
+        return 0;
     }
+    let handedness = view.r.dot(view.u.cross(view.f));
+    (area.signum() * eye_side.signum() * handedness.signum()) as i32
 }
 
 #[cfg(test)]
@@ -191,13 +176,9 @@ mod tests {
             let n = DVec3::new(next(), next(), next()).normalize();
             let centre = target + DVec3::new(next(), next(), next()) * 0.5;
             let (u, v) = (n.any_orthonormal_vector(), n.cross(n.any_orthonormal_vector()));
-            let tri: Vec<DVec4> = (0..3).map(|_| (centre + u * next() * 0.3 + v * next() * 0.3).extend(1.0)).collect();
-            let screen: Vec<DVec2> = tri
-                .iter()
-                .map(|p| view.to_camera(p.truncate()))
-                .filter(|c| c.z > 0.05)
-                .map(|c| view.project(c))
-                .collect();
+            let tri: Vec<DVec3> = (0..3).map(|_| centre + u * next() * 0.3 + v * next() * 0.3).collect();
+            let screen: Vec<DVec2> =
+                tri.iter().map(|&p| view.to_camera(p)).filter(|c| c.z > 0.05).map(|c| view.project(c)).collect();
             if screen.len() < 3 {
                 continue;
             }
@@ -205,7 +186,8 @@ mod tests {
             if area.abs() < 1e-3 {
                 continue;
             }
-            let w = screen_winding(&view, &tri, n, -n.dot(centre));
+            let plane = Plane::new(n, centre);
+            let w = screen_winding(&view, crate::geometry::newell_normal(&tri), &plane);
             assert_eq!(w, area.signum() as i32, "eye {eye} target {target} n {n}");
             checked += 1;
         }

@@ -189,7 +189,7 @@ fn shadow_polygons(
                 piece.add(camera, scratch, front);
                 if !far_outline {
                     piece.add(camera, scratch, back);
-                } else if let Some(w) = piece.add_far(camera, scratch, back, !proj.clipped) {
+                } else if let Some(w) = piece.add_far(camera, scratch, back, proj) {
                     wound[p as usize].store(w, Ordering::Relaxed);
                 }
             }
@@ -386,8 +386,8 @@ impl Piece {
         }
     }
 
-    /// Puts far cap `sp` (if one was made; `projected_whole`: its corners' projections,
-    /// uncut) through `camera`, for the far outline. A cap whole on screen too gives the way
+    /// Puts far cap `sp` (if one was made; `proj` made it, and holds it in the world)
+    /// through `camera`, for the far outline. A cap whole on screen too gives the way
     /// it winds (+1: counter-clockwise), and its edges are left to the edges' pass; any other
     /// keeps its screen edges here, wound so that its inside winds +1. A cap with no area
     /// about the far plane's normal (which the projection never gives) is kept as a polygon.
@@ -396,17 +396,17 @@ impl Piece {
         camera: &Camera,
         scratch: &mut Scratch,
         sp: Option<ShadowPolygon>,
-        projected_whole: bool,
+        proj: &Projector,
     ) -> Option<i8> {
         let sp = sp?;
-        let winding = sp.plane.map_or(0, |f| far_outline::screen_winding(camera.view, &sp.verts, f.n, f.d));
+        let winding = sp.plane.map_or(0, |f| far_outline::screen_winding(camera.view, newell_normal(&proj.shadow), &f));
         if winding == 0 {
             self.add(camera, scratch, Some(sp));
             return None;
         }
         self.made[sp.part as usize] += 1;
         if let Screened::On(_) = scratch.screen(camera, &sp) {
-            if projected_whole && scratch.whole && scratch.ring.len() == sp.verts.len() {
+            if !proj.clipped && scratch.whole {
                 return Some(winding as i8);
             }
             far_outline::push_ring(&scratch.ring, winding, &mut self.far);
