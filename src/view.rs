@@ -320,24 +320,44 @@ impl View {
         let [a, b] = scratch;
         a.clear();
         a.extend(verts.iter().map(|&h| self.homogeneous_in_camera(h)));
-        let g = 1e4 * (self.t * self.aspect).max(self.t);
-        let near = self.near;
-        let planes: [&dyn Fn(DVec4) -> f64; 5] = [
-            &|c: DVec4| c.z - near * c.w,
-            &|c: DVec4| g * c.z - c.x,
-            &|c: DVec4| g * c.z + c.x,
-            &|c: DVec4| g * c.z - c.y,
-            &|c: DVec4| g * c.z + c.y,
-        ];
         let mut whole = true;
-        for plane in planes {
-            whole &= !clip_in_place(a, b, plane);
+        for keeps in self.homogeneous_clips() {
+            whole &= !clip_in_place(a, b, keeps);
         }
         if a.len() < 3 {
             return None;
         }
         out.extend(a.iter().map(|c| self.project(c.truncate())));
         out.iter().all(|p| p.is_finite()).then_some(whole)
+    }
+
+    /// Whether [`Self::clip_project_homogeneous`] would find polygon `verts` whole on screen
+    /// (`Some(true)`: no corner outside a clip, every image finite), found from the corners
+    /// alone without making the outline. `false` whenever it would not, and for a corner it
+    /// cannot place.
+    pub(crate) fn whole_on_screen(&self, verts: impl ExactSizeIterator<Item = DVec4>) -> bool {
+        let clips = self.homogeneous_clips();
+        verts.len() >= 3
+            && verts.into_iter().all(|h| {
+                let c = self.homogeneous_in_camera(h);
+                clips.iter().all(|keeps| keeps(c) >= 0.0) && self.project(c.truncate()).is_finite()
+            })
+    }
+
+    /// The half-spaces [`Self::clip_project_homogeneous`] keeps, as distances of a point in
+    /// camera coordinates (`>= 0`: kept): the near plane, then the guard band's four sides.
+    fn homogeneous_clips(&self) -> [impl Fn(DVec4) -> f64; 5] {
+        let g = 1e4 * (self.t * self.aspect).max(self.t);
+        let near = self.near;
+        std::array::from_fn(move |k| {
+            move |c: DVec4| match k {
+                0 => c.z - near * c.w,
+                1 => g * c.z - c.x,
+                2 => g * c.z + c.x,
+                3 => g * c.z - c.y,
+                _ => g * c.z + c.y,
+            }
+        })
     }
 
     /// The near plane (normal along the view direction) and the corners of the part of it

@@ -58,6 +58,7 @@ use crate::stats::Counters;
 use crate::view::DepthPlane;
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
+use smallvec::{smallvec, SmallVec};
 use std::sync::atomic::{AtomicI8, Ordering};
 use std::sync::Arc;
 
@@ -110,8 +111,9 @@ pub enum Part {
 /// One shadow polygon in world space.
 #[derive(Debug, Clone)]
 pub struct ShadowPolygon {
-    /// Its vertices in homogeneous coordinates (`w = 0`: a point at infinity).
-    pub verts: Vec<DVec4>,
+    /// Its vertices in homogeneous coordinates (`w = 0`: a point at infinity), kept inline
+    /// up to four (a million caps a frame on s3, none of them allocated).
+    pub verts: SmallVec<[DVec4; 4]>,
     /// Its plane; `None` for a back cap, which lies on the plane at infinity.
     pub plane: Option<Plane>,
     /// The polygon's weight in the count (how many volumes it bounds: 1, or 2 on a merged
@@ -185,11 +187,15 @@ fn shadow_polygons(
         |(scratch, proj), polys| {
             let mut piece = Piece::default();
             for &p in polys.iter().filter(|&&p| casts(p as usize)) {
-                let [front, back] = b.caps(proj, ctx.scene.verts(p as usize), p as usize, None);
-                piece.add(camera, scratch, front);
+                let verts = ctx.scene.verts(p as usize);
                 if !far_outline {
-                    piece.add(camera, scratch, back);
-                } else if let Some(w) = piece.add_far(camera, scratch, back, proj) {
+                    for cap in b.caps(proj, verts, p as usize, None) {
+                        piece.add(camera, scratch, cap);
+                    }
+                    continue;
+                }
+                piece.add(camera, scratch, Some(b.front_cap(verts, p as usize, None)));
+                if let Some(w) = piece.add_far(camera, scratch, &b, proj, verts) {
                     wound[p as usize].store(w, Ordering::Relaxed);
                 }
             }
@@ -386,20 +392,37 @@ impl Piece {
         }
     }
 
-    /// Puts far cap `sp` (if one was made; `proj` made it, and holds it in the world)
-    /// through `camera`, for the far outline. A cap whole on screen too gives the way
+    /// Makes the far cap of polygon `verts` (`b` has the far plane; `proj` is scratch) and
+    /// puts it through `camera`, for the far outline. A cap whole on screen too gives the way
     /// it winds (+1: counter-clockwise), and its edges are left to the edges' pass; any other
     /// keeps its screen edges here, wound so that its inside winds +1. A cap with no area
     /// about the far plane's normal (which the projection never gives) is kept as a polygon.
+    /// Whether a cap is whole is found from its corners first, without its outline, which a
+    /// whole cap does not keep.
     fn add_far(
         &mut self,
         camera: &Camera,
         scratch: &mut Scratch,
-        sp: Option<ShadowPolygon>,
-        proj: &Projector,
+        b: &Builder,
+        proj: &mut Projector,
+        verts: &[DVec3],
     ) -> Option<i8> {
-        let sp = sp?;
-        let winding = sp.plane.map_or(0, |f| far_outline::screen_winding(camera.view, newell_normal(&proj.shadow), &f));
+        let far = b.far.as_ref()?;
+        if !proj.project(verts, far) {
+            return None;
+        }
+        let view = camera.view;
+        let winding = far_outline::screen_winding(view, newell_normal(&proj.shadow), &far.plane);
+        let whole = || {
+            !proj.clipped
+                && view.depth_plane(&far.plane).is_some()
+                && view.whole_on_screen(proj.shadow.iter().map(|&v| finite(v)))
+        };
+        if winding != 0 && whole() {
+            self.made[Part::FarCap as usize] += 1;
+            return Some(winding as i8);
+        }
+        let sp = b.far_cap(proj, far, None);
         if winding == 0 {
             self.add(camera, scratch, Some(sp));
             return None;
@@ -493,8 +516,8 @@ impl<'c> Builder<'c> {
             return None; // the light lies on the edge's line: the side has no area
         }
         let verts = match self.sample {
-            LightSample::Point(_) => vec![finite(a), finite(b), self.away(b), self.away(a)],
-            LightSample::Directional(_) => vec![finite(a), finite(b), self.away(a)],
+            LightSample::Point(_) => smallvec![finite(a), finite(b), self.away(b), self.away(a)],
+            LightSample::Directional(_) => smallvec![finite(a), finite(b), self.away(a)],
         };
         let sign = self.eye_sign(n, a) * w.abs();
         Some(ShadowPolygon {
@@ -516,30 +539,13 @@ impl<'c> Builder<'c> {
         poly: usize,
         owner: Option<u32>,
     ) -> [Option<ShadowPolygon>; 2] {
-        let plane = self.ctx.scene.polygons[poly].plane;
         match self.counting {
             Counting::ZFail => {
-                let toward = plane.n * light_side(&plane, self.sample);
-                let sign = self.eye_sign(toward, verts[0]);
-                let front = ShadowPolygon {
-                    verts: verts.iter().map(|&v| finite(v)).collect(),
-                    plane: Some(plane),
-                    sign,
-                    part: Part::FrontCap,
-                    lies_on: Some(poly as u32),
-                    owner_face: owner,
-                };
+                let front = self.front_cap(verts, poly, owner);
                 let back = match &self.far {
                     // Closed at the far plane: the volume's cross-section there, which
                     // every count behind a visible point starts from.
-                    Some(far) => proj.project(verts, far).then(|| ShadowPolygon {
-                        verts: proj.shadow.iter().map(|&v| finite(v)).collect(),
-                        plane: Some(far.plane),
-                        sign: -1,
-                        part: Part::FarCap,
-                        lies_on: None,
-                        owner_face: owner,
-                    }),
+                    Some(far) => proj.project(verts, far).then(|| self.far_cap(proj, far, owner)),
                     // For a directional light every direction away is the same point at
                     // infinity: the sides close the volume there and no back cap is needed.
                     None => matches!(self.sample, LightSample::Point(_)).then(|| ShadowPolygon {
@@ -568,6 +574,33 @@ impl<'c> Builder<'c> {
                 [cap, None]
             }
             Counting::NaiveZPass => [None, None],
+        }
+    }
+
+    /// Z-fail's front cap of the volume of `verts` (on scene polygon `poly`): the polygon
+    /// itself.
+    fn front_cap(&self, verts: &[DVec3], poly: usize, owner: Option<u32>) -> ShadowPolygon {
+        let plane = self.ctx.scene.polygons[poly].plane;
+        let toward = plane.n * light_side(&plane, self.sample);
+        ShadowPolygon {
+            verts: verts.iter().map(|&v| finite(v)).collect(),
+            plane: Some(plane),
+            sign: self.eye_sign(toward, verts[0]),
+            part: Part::FrontCap,
+            lies_on: Some(poly as u32),
+            owner_face: owner,
+        }
+    }
+
+    /// Z-fail's far cap on `far`, the shadow `proj` has just made there.
+    fn far_cap(&self, proj: &Projector, far: &Target, owner: Option<u32>) -> ShadowPolygon {
+        ShadowPolygon {
+            verts: proj.shadow.iter().map(|&v| finite(v)).collect(),
+            plane: Some(far.plane),
+            sign: -1,
+            part: Part::FarCap,
+            lies_on: None,
+            owner_face: owner,
         }
     }
 
@@ -1176,7 +1209,7 @@ impl Scratch {
             }
             cut = true;
         }
-        let verts = if cut { &self.cut } else { &sp.verts };
+        let verts: &[DVec4] = if cut { &self.cut } else { &sp.verts };
         // A back cap lies on the plane at infinity: inverse depth 0, behind everything.
         let depth = match &sp.plane {
             Some(plane) => match view.depth_plane(plane) {
