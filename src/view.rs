@@ -275,12 +275,19 @@ impl View {
         self.eye + s * d
     }
 
+    /// Whether the eye lies in `plane`: it sees the plane edge-on, and it has no
+    /// [`View::depth_plane`].
+    #[inline]
+    pub(crate) fn edge_on(&self, plane: &Plane) -> bool {
+        plane.distance(self.eye) == 0.0
+    }
+
     /// The inverse-depth plane of a world plane; `None` when the eye lies in it (edge-on).
     pub(crate) fn depth_plane(&self, plane: &Plane) -> Option<DepthPlane> {
-        let e = plane.distance(self.eye);
-        if e == 0.0 {
+        if self.edge_on(plane) {
             return None;
         }
+        let e = plane.distance(self.eye);
         // 1/z = -(n.f + sx n.r + sy n.u) / e, with sx, sy affine in x, y.
         let k = -1.0 / e;
         let (nr, nu) = (plane.n.dot(self.r) * self.t * self.aspect, plane.n.dot(self.u) * self.t);

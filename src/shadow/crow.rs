@@ -33,7 +33,6 @@ use super::{
 };
 use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
 use crate::stats::Counters;
-use crate::view::DepthPlane;
 use crate::visibility::Run;
 use glam::DVec2;
 
@@ -215,12 +214,16 @@ impl Walker<'_> {
     /// Step 2, the plane crossings: where each covering piece starts and stops adding to the
     /// count along the run (`events`), a piece whose shadow polygon crosses the run's plane
     /// inside it being cut at the first pixel that counts differently.
-    fn count_events(&mut self, k: usize, run: &Run, bd: DepthPlane, pieces: &[(u32, u32, u32)]) {
-        let polys = &self.stage.samples[k].volumes.polys;
-        let (b, face) = (run.poly, self.stage.ctx.scene.polygons[run.poly as usize].face);
-        let (counting, yc, record) = (self.stage.counting, self.yc, self.stage.ctx.keep_outlines);
+    /// The run's depth plane is worked out only when a piece covers it (ours: most runs have
+    /// none).
+    fn count_events(&mut self, k: usize, run: &Run, pieces: &[(u32, u32, u32)]) {
         self.events.clear();
         self.last_adds.clear();
+        let polys = &self.stage.samples[k].volumes.polys;
+        let (b, poly) = (run.poly, &self.stage.ctx.scene.polygons[run.poly as usize]);
+        let Some(bd) = pieces.first().and_then(|_| self.stage.ctx.view.depth_plane(&poly.plane)) else { return };
+        let face = poly.face;
+        let (counting, yc, record) = (self.stage.counting, self.yc, self.stage.ctx.keep_outlines);
         for &(t, s, e) in pieces.iter().filter(|p| p.1 < p.2) {
             let p = &polys[t as usize];
             // What polygon p adds to the count at pixel x (see `count_at`).
@@ -346,14 +349,14 @@ impl ShadowWalker for Walker<'_> {
 
     fn lit(&mut self, light: usize, sample: usize, _line: u32, run: &Run, lit: &mut [f32]) {
         let k = self.stage.ctx.sample_index(light, sample);
-        let scene = self.stage.ctx.scene;
-        let Some(bd) = self.stage.ctx.view.depth_plane(&scene.polygons[run.poly as usize].plane) else {
+        let ctx = self.stage.ctx;
+        if ctx.view.edge_on(&ctx.scene.polygons[run.poly as usize].plane) {
             lit.fill(1.0);
             return;
-        };
+        }
         let mut pieces = std::mem::take(&mut self.last_pieces);
         self.lines[k].pieces_in(run, &mut pieces);
-        self.count_events(k, run, bd, &pieces);
+        self.count_events(k, run, &pieces);
         let from = self.events.len();
         self.lines[k].far.events_in(run, &mut self.events);
         if self.stage.ctx.keep_outlines {
