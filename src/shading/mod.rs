@@ -174,6 +174,11 @@ struct Term {
 pub(crate) struct LineShading {
     lanes: LineLanes,
     run: RunShading,
+    /// The corners and vertex normals of each run's triangle (zero for other polygons),
+    /// gathered for the whole line before its first run is shaded (ours): the runs' reads,
+    /// independent of one another, then wait on memory together, not one run after another
+    /// (a line of s3 meets some five hundred triangles, most of them for the first time).
+    triangles: Vec<[DVec3; 6]>,
     /// Every run on the f64 path (the tests compare the two paths with it).
     f64_only: bool,
     /// Gouraud and Phong runs shaded in lanes and in f64.
@@ -198,6 +203,8 @@ struct RunShading {
     /// where the polygon meets the scan plane.
     crossings: Vec<ScanCrossing>,
     along: DVec3,
+    /// The run's triangle's corners and vertex normals (zero for other polygons).
+    triangle: [DVec3; 6],
     /// The larger `|p - eye|` of the run's ends (for runs in lanes), the ray through its
     /// first pixel, and its plane's `depth` and `den` (see [`lanes`]).
     reach: f64,
@@ -303,10 +310,13 @@ impl<'a> Shader<'a> {
         // The scan plane holds the eye and every ray of this scanline.
         rs.scan_normal = self.view.ray(0.0, rs.yc).cross(self.view.r);
         rs.ray_row = self.view.ray(0.5, rs.yc);
-        for run in runs {
+        ls.triangles.clear();
+        ls.triangles.extend(runs.iter().map(|run| self.triangle(run.poly as usize)));
+        for (run, triangle) in runs.iter().zip(&ls.triangles) {
             let (x0, x1) = (run.x0 as usize, run.x1 as usize);
             let lit = |k: usize| &lit[k * width + x0..k * width + x1];
             self.begin_run(run, rs);
+            rs.triangle = *triangle;
             ls.lanes.start_run(x0, x1, self.ambient(rs.poly));
             let in_lanes = match self.scene.material(rs.poly).shading {
                 ShadingMode::Flat => {
@@ -484,14 +494,21 @@ impl<'a> Shader<'a> {
     /// Equal to the crossings' interpolation (linear along the edges, then along the scan
     /// plane), which for a triangle is barycentric.
     fn triangle_normals(&self, rs: &RunShading) -> Option<[DVec3; 2]> {
-        let v = self.scene.verts(rs.poly);
-        let vn = self.scene.vertex_normals(rs.poly);
+        let (v, vn) = rs.triangle.split_at(3);
         let eye = self.view.eye;
         let [a, b, c] = [v[0] - eye, v[1] - eye, v[2] - eye];
         let e = [b.cross(c), c.cross(a), a.cross(b)];
         let sign = (e[0] + e[1] + e[2]).dot(rs.ray).signum() * rs.flip;
         let along = |d: DVec3| (vn[0] * e[0].dot(d) + vn[1] * e[1].dot(d) + vn[2] * e[2].dot(d)) * sign;
         Some([along(rs.ray), along(self.view.ray_step())])
+    }
+
+    /// Polygon `poly`'s corners and vertex normals when it is a triangle (zero otherwise).
+    fn triangle(&self, poly: usize) -> [DVec3; 6] {
+        match (self.scene.verts(poly), self.scene.vertex_normals(poly)) {
+            (&[a, b, c], &[na, nb, nc]) => [a, b, c, na, nb, nc],
+            _ => [DVec3::ZERO; 6],
+        }
     }
 
     /// A run's interpolated normal between its two crossings, unnormalised, as
