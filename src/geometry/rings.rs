@@ -64,20 +64,26 @@ impl Rings {
 }
 
 /// Rings kept in the pieces a parallel loop made them in, read as one list: ring `i` is
-/// found by bisection over the pieces' first indices. Joining the pieces into one
-/// [`Rings`] would hold every point twice while it copies (z-fail's million caps on s3:
-/// 72 MB more at the frame's peak).
+/// found through the number of the piece that holds it, four bytes a ring (a bisection over
+/// the pieces' first indices, three times a ring as z-fail's edge table is built, was a
+/// twentieth of Crow's z-fail frame on s3). Joining the pieces into one [`Rings`] would hold
+/// every point twice while it copies (z-fail's million caps on s3: 72 MB more at the
+/// frame's peak).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct RingPieces {
     parts: Vec<Rings>,
     /// `first[k]`: the index of part `k`'s first ring; one more entry, the count.
     first: Vec<usize>,
+    /// `part[i]`: the part that holds ring `i`.
+    part: Vec<u32>,
 }
 
 impl RingPieces {
     /// The bytes its parts hold.
     pub fn bytes(&self) -> usize {
-        self.parts.iter().map(Rings::bytes).sum::<usize>() + crate::pool::held(&self.first)
+        self.parts.iter().map(Rings::bytes).sum::<usize>()
+            + crate::pool::held(&self.first)
+            + crate::pool::held(&self.part)
     }
 
     /// The rings of every part, in order.
@@ -86,7 +92,8 @@ impl RingPieces {
         let parts_and_first = parts.into_iter().zip(first).filter(|(p, _)| p.count() > 0);
         let (parts, mut first): (Vec<Rings>, Vec<usize>) = parts_and_first.unzip();
         first.push(parts.iter().map(|p| p.count()).sum());
-        RingPieces { parts, first }
+        let part = parts.iter().enumerate().flat_map(|(k, p)| std::iter::repeat_n(k as u32, p.count())).collect();
+        RingPieces { parts, first, part }
     }
 
     /// The rings in order.
@@ -101,8 +108,7 @@ impl RingList for RingPieces {
     }
 
     fn ring(&self, i: usize) -> &[DVec2] {
-        // The last part whose first ring is at or before `i` (empty parts were left out).
-        let k = self.first.partition_point(|&f| f <= i) - 1;
+        let k = self.part[i] as usize;
         self.parts[k].ring(i - self.first[k])
     }
 }
