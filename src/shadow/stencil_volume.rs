@@ -45,7 +45,10 @@ impl<'a> StencilVolume<'a> {
                 line[r.x0 as usize..r.x1 as usize].fill(r.poly);
             }
         });
-        let planes: Vec<Option<DepthPlane>> = scene.polygons.par_iter().map(|p| view.depth_plane(&p.plane)).collect();
+        // The depth planes of the polygons seen at some pixel, the only ones asked for.
+        let planes: Vec<Option<DepthPlane>> = (scene.polygons.par_iter().zip(&ctx.visible))
+            .map(|(p, &seen)| seen.then(|| view.depth_plane(&p.plane)).flatten())
+            .collect();
         let adjacency = Adjacency::kept(scene, options.construction != Construction::PerPolygon, &ctx.pools.stash);
         let counting = options.counting;
         let band = crate::scan::band_height(h);
