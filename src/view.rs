@@ -481,6 +481,37 @@ mod tests {
         View::new(&cam)
     }
 
+    /// `whole_on_screen` says "whole" exactly where the clipper would find the polygon
+    /// whole: random triangles and quads in front of the eye, across the near plane, beyond
+    /// the guard band, behind the eye, and with corners at infinity (`w = 0`).
+    #[test]
+    fn whole_on_screen_is_what_the_clipper_finds_whole() {
+        use rand::{Rng, SeedableRng};
+        let v = view();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(40);
+        let (mut scratch, mut out) = ([Vec::new(), Vec::new()], Vec::new());
+        let mut seen = [0; 2];
+        for _ in 0..20_000 {
+            let n = rng.gen_range(3..=4);
+            let spread = [0.5, 5.0, 1e5][rng.gen_range(0..3)];
+            let verts: Vec<DVec4> = (0..n)
+                .map(|_| {
+                    let p = DVec3::new(
+                        rng.gen_range(-spread..spread),
+                        rng.gen_range(-spread..spread),
+                        rng.gen_range(-8.0..5.2),
+                    );
+                    p.extend(if rng.gen_bool(0.1) { 0.0 } else { 1.0 })
+                })
+                .collect();
+            let whole = v.whole_on_screen(verts.iter().copied());
+            let clipped = v.clip_project_homogeneous(&verts, &mut scratch, &mut out);
+            assert_eq!(whole, clipped == Some(true), "{verts:?}");
+            seen[usize::from(whole)] += 1;
+        }
+        assert!(seen[0] > 1000 && seen[1] > 1000, "both kinds: {seen:?}");
+    }
+
     #[test]
     fn projection_and_ray_agree() {
         let v = view();

@@ -414,9 +414,7 @@ impl Piece {
         let view = camera.view;
         let winding = far_outline::screen_winding(view, newell_normal(&proj.shadow), &far.plane);
         let whole = || {
-            !proj.clipped
-                && view.depth_plane(&far.plane).is_some()
-                && view.whole_on_screen(proj.shadow.iter().map(|&v| finite(v)))
+            !proj.clipped && !view.edge_on(&far.plane) && view.whole_on_screen(proj.shadow.iter().map(|&v| finite(v)))
         };
         if winding != 0 && whole() {
             self.made[Part::FarCap as usize] += 1;
