@@ -932,6 +932,21 @@ impl OpenSet {
 mod tests {
     use super::*;
 
+    /// The keys the walk sorts entering edges by order x as `f64::total_cmp` does: signed
+    /// zeros, infinities, subnormals and random values of both signs, every pair.
+    #[test]
+    fn ordered_bits_order_as_total_cmp() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut xs = vec![0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, f64::MIN_POSITIVE / 4.0, -f64::MIN_POSITIVE];
+        xs.extend((0..200).map(|_| rng.gen_range(-1e3..1e3) * 10f64.powi(rng.gen_range(-300..300))));
+        for &a in &xs {
+            for &b in &xs {
+                assert_eq!(ordered_bits(a).cmp(&ordered_bits(b)), a.total_cmp(&b), "{a} against {b}");
+            }
+        }
+    }
+
     #[test]
     fn every_thread_gets_as_many_bands_of_at_most_64_lines() {
         for threads in 1..=4 {
