@@ -221,7 +221,10 @@ impl Walker<'_> {
         self.last_adds.clear();
         let polys = &self.stage.samples[k].volumes.polys;
         let (b, poly) = (run.poly, &self.stage.ctx.scene.polygons[run.poly as usize]);
-        let Some(bd) = pieces.first().and_then(|_| self.stage.ctx.view.depth_plane(&poly.plane)) else { return };
+        if pieces.is_empty() {
+            return;
+        }
+        let Some(bd) = self.stage.ctx.view.depth_plane(&poly.plane) else { return };
         let face = poly.face;
         let (counting, yc, record) = (self.stage.counting, self.yc, self.stage.ctx.keep_outlines);
         for &(t, s, e) in pieces.iter().filter(|p| p.1 < p.2) {

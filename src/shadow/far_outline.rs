@@ -12,7 +12,7 @@
 //! silhouette's sides (on s3, the far caps of 490,095 triangles).
 //!
 //! 1. **Wound alike.** Each far cap is put on screen as before, and its edges are kept wound
-//!    so that its inside has winding number +1 ([`screen_winding`], from its normal in the
+//!    so that its inside has winding number +1 ([`wound`], from its normal in the
 //!    world, never from its screen area, which rounding can turn for a sliver).
 //! 2. **Cancelled.** A cap *whole* on screen (nothing of it cut, by the projection's clips
 //!    or the camera's) is its corners' images, each worked out from the corner alone
@@ -120,20 +120,31 @@ pub(crate) fn cancel(mut edges: Vec<FarEdge>) -> Vec<FarEdge> {
     edges
 }
 
-/// Step 1: which way a far cap winds on screen, +1 counter-clockwise (positive shoelace
-/// area), from its Newell normal in the world (`newell`) on `plane`: the sign of its area
-/// about the plane's normal, times `view`'s side of the plane, times the handedness of the
-/// camera's axes. The perspective projection gives a small patch at camera point `c`
-/// with normal `N` the orientation of `N · c` in `(x/z, y/z)`, and the screen's `y` runs
-/// down; `N · c` has the sign of the area about `n` times minus the eye's side, for every
-/// point of the plane. Zero for a cap with no area about the normal.
-pub(crate) fn screen_winding(view: &View, newell: DVec3, plane: &Plane) -> i32 {
-    let (area, eye_side) = (newell.dot(plane.n), plane.distance(view.eye));
-    if area == 0.0 || eye_side == 0.0 {
+/// What every patch of `plane` with positive area about its normal winds on screen: `view`'s
+/// side of the plane times the handedness of the camera's axes (0 when the eye lies in the
+/// plane). The perspective projection gives a small patch at camera point `c` with normal
+/// `N` the orientation of `N · c` in `(x/z, y/z)`, and the screen's `y` runs down; `N · c`
+/// has the sign of the area about the normal times minus the eye's side, for every point of
+/// the plane. One number for the whole plane, worked out once for all its caps.
+pub(crate) fn facing(view: &View, plane: &Plane) -> i32 {
+    let eye_side = plane.distance(view.eye);
+    if eye_side == 0.0 {
         return 0;
     }
     let handedness = view.r.dot(view.u.cross(view.f));
-    (area.signum() * eye_side.signum() * handedness.signum()) as i32
+    (eye_side.signum() * handedness.signum()) as i32
+}
+
+/// Step 1: which way a far cap winds on screen, +1 counter-clockwise (positive shoelace
+/// area), from its Newell normal in the world (`newell`) on `plane`, whose [`facing`] is
+/// `facing`: the sign of its area about the plane's normal times the facing. Zero for a cap
+/// with no area about the normal, or on a plane the eye sees edge-on.
+pub(crate) fn wound(newell: DVec3, plane: &Plane, facing: i32) -> i32 {
+    let area = newell.dot(plane.n);
+    if area == 0.0 {
+        return 0;
+    }
+    area.signum() as i32 * facing
 }
 
 #[cfg(test)]
@@ -187,7 +198,7 @@ mod tests {
                 continue;
             }
             let plane = Plane::new(n, centre);
-            let w = screen_winding(&view, crate::geometry::newell_normal(&tri), &plane);
+            let w = wound(crate::geometry::newell_normal(&tri), &plane, facing(&view, &plane));
             assert_eq!(w, area.signum() as i32, "eye {eye} target {target} n {n}");
             checked += 1;
         }

@@ -411,12 +411,10 @@ impl Piece {
         if !proj.project(verts, far) {
             return None;
         }
-        let view = camera.view;
-        let winding = far_outline::screen_winding(view, newell_normal(&proj.shadow), &far.plane);
-        let whole = || {
-            !proj.clipped && !view.edge_on(&far.plane) && view.whole_on_screen(proj.shadow.iter().map(|&v| finite(v)))
-        };
-        if winding != 0 && whole() {
+        // A winding of zero also stands for a far plane seen edge-on, which the camera's trip
+        // would refuse: a cap found whole here is one it would take whole.
+        let winding = far_outline::wound(newell_normal(&proj.shadow), &far.plane, b.far_facing);
+        if winding != 0 && !proj.clipped && camera.view.whole_on_screen(proj.shadow.iter().map(|&v| finite(v))) {
             self.made[Part::FarCap as usize] += 1;
             return Some(winding as i8);
         }
@@ -446,13 +444,16 @@ struct Builder<'c> {
     /// Z-fail's far plane and the part of it behind the scene, for the far caps (none:
     /// back caps at infinity).
     far: Option<Target>,
+    /// How the far plane's patches wind on screen ([`far_outline::facing`]; 0 without it).
+    far_facing: i32,
 }
 
 impl<'c> Builder<'c> {
     fn new(ctx: &'c ShadowContext<'c>, sample: LightSample, counting: Counting, far: Option<&FarPlane>) -> Self {
         let (plane, rect) = ctx.view.near_rectangle();
         let far = far.map(|f| Target::new(f.plane, f.rect, sample));
-        Builder { ctx, sample, counting, near: Target::new(plane, rect, sample), far }
+        let far_facing = far.as_ref().map_or(0, |f| far_outline::facing(ctx.view, &f.plane));
+        Builder { ctx, sample, counting, near: Target::new(plane, rect, sample), far, far_facing }
     }
 
     /// Corner `v`'s image on screen as a far cap whole on screen has it: projected from the
