@@ -70,8 +70,10 @@ pub(crate) struct ScreenPolygon {
 }
 
 /// How many bits of a screen polygon's number give its place in its part: a part holds at
-/// most `1 << PART_BITS` polygons (those of one chunk of scene polygons).
-const PART_BITS: u32 = 12;
+/// most `1 << PART_BITS` polygons (those of one chunk of scene polygons). 1,024: s2's
+/// 100,000 polygons make 98 chunks, six or more for each of sixteen threads (at 4,096 they
+/// made 25, and half the threads clipped two while the rest waited).
+const PART_BITS: u32 = 10;
 
 /// The screen polygons of a view, in parts of at most `1 << PART_BITS`, each part's rings
 /// stored one after another in one buffer (a million triangles are a million rings: one

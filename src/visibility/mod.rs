@@ -100,7 +100,14 @@ impl FrameRuns {
         use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
         let mut seen = Vec::new();
         seen.par_extend((0..n).into_par_iter().map(|_| AtomicBool::new(false)));
-        self.lines.par_iter().for_each(|line| line.iter().for_each(|r| seen[r.poly as usize].store(true, Relaxed)));
+        // Read before written: a polygon is seen in many runs, and threads that all wrote
+        // its flag would pass the flag's cache line between their cores at every run.
+        let mark = |f: &AtomicBool| {
+            if !f.load(Relaxed) {
+                f.store(true, Relaxed);
+            }
+        };
+        self.lines.par_iter().for_each(|line| line.iter().for_each(|r| mark(&seen[r.poly as usize])));
         seen.into_par_iter().map(AtomicBool::into_inner).collect()
     }
 
