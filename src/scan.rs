@@ -325,24 +325,27 @@ impl EdgeTable {
         table
     }
 
-    /// Makes room for `more` edges, exactly.
-    pub(crate) fn reserve_exact(&mut self, more: usize) {
-        self.edges.reserve_exact(more);
-    }
-
-    /// Adds `other`'s edges (neither table sorted yet) after this table's, their tags raised
-    /// by `tag`: the table adding `other`'s rings here in turn would build. `other` is let go
-    /// as soon as it is read, so that the two exist at once for no longer than the copy.
-    pub(crate) fn append(&mut self, other: EdgeTable, tag: u32) {
-        let start = self.edges.len();
-        self.edges.extend(other.edges.iter().map(|&e| Edge { tag: e.tag + tag, ..e }));
-        drop(other);
-        if self.in_place {
-            for (seq, e) in (start as u32..).zip(&mut self.edges[start..]) {
-                e.seq = seq;
-            }
-        }
-        self.built = false;
+    /// The edges of `parts` (tables made alike, none sorted yet), one part after another,
+    /// the tags of part `k` raised by `tags[k]`: the table adding their rings in turn would
+    /// build. Copied by all threads, each part into its own stretch (s3's floor under
+    /// Bouknight-Kelley joins 1.47 million edges from its pieces: 73 ms on one thread, the
+    /// largest serial step of its preparation at sixteen threads).
+    pub(crate) fn joined(parts: Vec<EdgeTable>, tags: &[u32]) -> Option<EdgeTable> {
+        let starts = starts(parts.iter().map(|t| t.edges.len()));
+        let in_place = parts.first()?.in_place;
+        let edges = {
+            let lists: Vec<&[Edge]> = parts.iter().map(|t| &t.edges[..]).collect();
+            // A part sorted where it lies numbers its edges from 0; the join numbers them on.
+            crate::pieces::joined(&lists, |k, e| Edge {
+                tag: e.tag + tags[k],
+                seq: if in_place { e.seq + starts[k] as u32 } else { e.seq },
+                ..*e
+            })
+        };
+        let mut parts = parts.into_iter();
+        let first = parts.next()?;
+        crate::pieces::let_go(parts.collect());
+        Some(EdgeTable { edges, built: false, ..first })
     }
 
     /// Sorts the edges into buckets by first line (a counting sort, stable: a line's edges
@@ -1172,11 +1175,7 @@ mod tests {
             })
             .collect();
         let join = |tags: [u32; 3]| {
-            let mut parts = pieces.clone().into_iter();
-            let mut joined = parts.next().unwrap_or_default();
-            for (part, tag) in parts.zip(&tags[1..]) {
-                joined.append(part, *tag);
-            }
+            let mut joined = EdgeTable::joined(pieces.clone(), &tags).unwrap_or_default();
             joined.finish();
             joined
         };

@@ -93,19 +93,22 @@ impl ReceiverTable {
     }
 
     /// The polygons of `parts` (tables of one receiver, none finished), one part after
-    /// another: the table adding them in turn would build. Each part is let go once it is
-    /// copied, into room made once.
+    /// another: the table adding them in turn would build ([`EdgeTable::joined`]).
     pub(crate) fn joined(parts: Vec<ReceiverTable>) -> Option<Self> {
-        let more: usize = parts.iter().skip(1).map(|p| p.table.len()).sum();
-        let mut parts = parts.into_iter();
-        let mut joined = parts.next()?;
-        joined.table.reserve_exact(more);
-        for ReceiverTable { table, count, mut rings, .. } in parts {
-            joined.table.append(table, joined.count);
-            joined.count += count;
-            joined.rings.append(&mut rings);
-        }
-        Some(joined)
+        let tags = crate::pieces::starts(parts.iter().map(|p| p.count as usize));
+        let tags: Vec<u32> = tags.into_iter().map(|t| t as u32).collect();
+        let (receiver, keep_rings) = (parts.first()?.receiver, parts[0].keep_rings);
+        let count = parts.iter().map(|p| p.count).sum();
+        let mut rings = Vec::new();
+        let tables = parts
+            .into_iter()
+            .map(|mut p| {
+                rings.append(&mut p.rings);
+                p.table
+            })
+            .collect();
+        let table = EdgeTable::joined(tables, &tags)?;
+        Some(ReceiverTable { receiver, table, count, rings, keep_rings })
     }
 
     /// The receiver.
