@@ -878,17 +878,13 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
         if backgrounds && m.polys.iter().all(|p| p.casts) { wide_backgrounds(scene, m) } else { vec![false; n] };
     let kept: Vec<usize> = (0..n).into_par_iter().filter(|&i| !behind[i]).collect();
     // The items across each whole caster's edges, by their places among the kept (a whole
-    // polygon is mapped once a view, and the mapped polygons are in the order of their
-    // sources: a source's place is found by bisection): worked out in parallel, in order.
+    // polygon is mapped once a view: a source's place is read from `place`): worked out in
+    // parallel, in order.
     let sheet = |p: &MappedPolygon| p.casts && p.whole;
-    let sources: Vec<u32> = kept.par_iter().map(|&i| m.polys[i].source).collect();
-    debug_assert!(sources.windows(2).all(|w| w[0] < w[1]));
-    let local = |q: u32| {
-        let k = sources.partition_point(|&s| s < q);
-        match sources.get(k) {
-            Some(&s) if s == q && sheet(&m.polys[kept[k]]) => k as u32,
-            _ => NO_ITEM,
-        }
+    let place = places(m, &kept, scene.polygons.len());
+    let local = |q: u32| match place.get(q as usize) {
+        Some(&k) if k != NO_ITEM && sheet(&m.polys[kept[k as usize]]) => k,
+        _ => NO_ITEM,
     };
     let across: Vec<u32> = kept
         .par_iter()
@@ -921,12 +917,24 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
             Piece::new(p.source, Region { rings }, p.near)
         })
         .collect();
-    // By all threads: a kept polygon's place among the kept is found by bisection.
-    let sorted: Vec<bool> =
-        (0..n).into_par_iter().map(|i| !behind[i] && !found.lone[kept.partition_point(|&j| j < i)]).collect();
+    // By all threads: a kept polygon's place among the kept is read from `place`.
+    let lone_at = |i: usize| found.lone[place[m.polys[i].source as usize] as usize];
+    let sorted: Vec<bool> = (0..n).into_par_iter().map(|i| !behind[i] && !lone_at(i)).collect();
     let lone = kept.par_iter().zip(&found.lone).filter(|(_, &l)| l).map(|(&i, _)| m.polys[i].source).collect();
     let behind = (0..n).into_par_iter().filter(|&i| behind[i]).filter_map(|i| m.piece(&m.polys[i])).collect();
     LoneSplit { lone, outlines, behind, sorted }
+}
+
+/// `place[s]`: the place among `kept` (places in `m`) of the polygon mapped from scene
+/// polygon `s` (of `sources`), [`NO_ITEM`] for the others; a view maps a polygon at most
+/// once. Written by all threads: a million bisections over the kept polygons' sources, one
+/// for each edge of every whole caster, were a fifth of s3's pass 1 on one thread.
+fn places(m: &Mapped, kept: &[usize], sources: usize) -> Vec<u32> {
+    use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+    let mut place = Vec::new();
+    place.par_extend((0..sources).into_par_iter().map(|_| AtomicU32::new(NO_ITEM)));
+    kept.par_iter().enumerate().for_each(|(k, &i)| place[m.polys[i].source as usize].store(k as u32, Relaxed));
+    place.into_par_iter().map(AtomicU32::into_inner).collect()
 }
 
 /// Most wide polygons a light view tries as backgrounds.
