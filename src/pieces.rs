@@ -51,6 +51,21 @@ pub(crate) fn joined<S: Sync, T: Copy + Send + Sync>(parts: &[&[S]], f: impl Fn(
     list
 }
 
+/// `marked[i]`: whether `i` is among `indices` (each below `n`), marked by all threads. A
+/// flag is read before it is written: where an index comes many times, threads that all
+/// wrote it would pass its cache line between their cores each time.
+pub(crate) fn marked(n: usize, indices: impl ParallelIterator<Item = usize>) -> Vec<bool> {
+    use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
+    let mut flags = Vec::new();
+    flags.par_extend((0..n).into_par_iter().map(|_| AtomicBool::new(false)));
+    indices.for_each(|i| {
+        if !flags[i].load(Relaxed) {
+            flags[i].store(true, Relaxed);
+        }
+    });
+    flags.into_par_iter().map(AtomicBool::into_inner).collect()
+}
+
 /// Lets go of `list` by all threads: a list of many small allocations (a shadow database's
 /// million outlines) takes a thread tens of milliseconds to free, while the others wait.
 pub(crate) fn let_go<T: Send>(list: Vec<T>) {
@@ -60,6 +75,14 @@ pub(crate) fn let_go<T: Send>(list: Vec<T>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn marked_flags_each_index_given_once_or_many_times() {
+        let indices = vec![7usize, 3, 7, 7, 0];
+        let flags = marked(9, indices.into_par_iter());
+        let on: Vec<usize> = (0..9).filter(|&i| flags[i]).collect();
+        assert_eq!((flags.len(), on), (9, vec![0, 3, 7]));
+    }
 
     #[test]
     fn stretches_follow_one_another() {

@@ -289,6 +289,9 @@ fn project_piece(onto: Onto, candidates: &[u32], work: &mut Workspace) -> (Tally
     (tally, table, pairs)
 }
 
+/// Casters whose grid keys one piece of the grid's parallel loop writes.
+const KEY_CHUNK: usize = 4096;
+
 /// The most receivers one piece of the parallel loop over them takes.
 const RECEIVERS_PER_PIECE: usize = 512;
 
@@ -449,10 +452,7 @@ impl Extents {
     fn new(scene: &Scene, sample: LightSample, casters: &[u32], receivers: &[u32]) -> Self {
         let n = scene.polygons.len();
         // Only casters and receivers are asked about.
-        let mut wanted = vec![false; n];
-        for &i in casters.iter().chain(receivers) {
-            wanted[i as usize] = true;
-        }
+        let wanted = crate::pieces::marked(n, casters.par_iter().chain(receivers).map(|&i| i as usize));
         let (mut boxes, mut cones) = (Vec::new(), Vec::new());
         let asked = (0..n).into_par_iter().map(|i| wanted[i].then(|| scene.verts(i)));
         match sample {
@@ -549,15 +549,20 @@ impl SphereGrid {
             })
             .collect();
         let mut grid = SphereGrid { extents, g, cells, first: Vec::new(), binned: Vec::new() };
-        // Every (cell, caster) pair as one key, cell first: each caster counts its cells and
-        // fills its own stretch, and the keys are sorted, all by all threads (a million
-        // casters' pairs collected and counted into the cells on one thread were most of
-        // the grid's time). Each cell lists its casters in increasing order.
-        let counts: Vec<usize> = casters.par_iter().map(|&i| grid.cells_of(i).count()).collect();
+        // Every (cell, caster) pair as one key, cell first: each chunk of casters
+        // ([`KEY_CHUNK`]) counts their cells and fills its own stretch, and the keys are
+        // sorted, all by all threads (a million casters' pairs collected and counted into the
+        // cells on one thread were most of the grid's time; a stretch cut for each caster, a
+        // million on one thread, was a tenth of it). Each cell lists its casters in
+        // increasing order.
+        let chunks: Vec<&[u32]> = casters.chunks(KEY_CHUNK).collect();
+        let counts: Vec<usize> =
+            chunks.par_iter().map(|chunk| chunk.iter().map(|&i| grid.cells_of(i).count()).sum()).collect();
         let mut keys = vec![0u64; counts.iter().sum()];
-        crate::pieces::stretches(&mut keys, counts.iter().copied()).into_par_iter().zip(casters).for_each(
-            |(keys, &i)| {
-                for (key, (c, r)) in keys.iter_mut().zip(grid.cells_of(i)) {
+        crate::pieces::stretches(&mut keys, counts.iter().copied()).into_par_iter().zip(chunks).for_each(
+            |(keys, chunk)| {
+                let cells = chunk.iter().flat_map(|&i| grid.cells_of(i).map(move |(c, r)| (c, r, i)));
+                for (key, (c, r, i)) in keys.iter_mut().zip(cells) {
                     *key = ((c * g + r) as u64) << 32 | i as u64;
                 }
             },

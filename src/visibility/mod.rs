@@ -97,18 +97,7 @@ impl FrameRuns {
     /// marked by all threads, line by line.
     pub fn visible(&self, n: usize) -> Vec<bool> {
         use rayon::prelude::*;
-        use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
-        let mut seen = Vec::new();
-        seen.par_extend((0..n).into_par_iter().map(|_| AtomicBool::new(false)));
-        // Read before written: a polygon is seen in many runs, and threads that all wrote
-        // its flag would pass the flag's cache line between their cores at every run.
-        let mark = |f: &AtomicBool| {
-            if !f.load(Relaxed) {
-                f.store(true, Relaxed);
-            }
-        };
-        self.lines.par_iter().for_each(|line| line.iter().for_each(|r| mark(&seen[r.poly as usize])));
-        seen.into_par_iter().map(AtomicBool::into_inner).collect()
+        crate::pieces::marked(n, self.lines.par_iter().flat_map_iter(|line| line.iter().map(|r| r.poly as usize)))
     }
 
     /// Number of runs.
