@@ -77,8 +77,8 @@ impl Frame {
         Frame {
             width,
             height,
-            color: filled(n, background),
-            id: filled(n, BACKGROUND),
+            color: crate::pieces::filled(n, background),
+            id: crate::pieces::filled(n, BACKGROUND),
             // Each light's buffer its own zeroed allocation: `vec![v; lights]` would copy
             // the first into the others on one thread.
             light: (0..lights).map(|_| vec![0.0; n]).collect(),
@@ -367,15 +367,6 @@ fn png_bytes(img: &image::DynamicImage, path: &Path) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// `n` copies of `v`, written by the pool's threads in parallel: a 1080p frame's colour and
-/// ids are 33 MB, and first writes to fresh pages on one thread were the largest serial step
-/// of a one-frame render.
-fn filled<T: Copy + Send + Sync>(n: usize, v: T) -> Vec<T> {
-    use rayon::prelude::*;
-    let mut out = Vec::with_capacity(n);
-    out.par_extend(rayon::iter::repeat_n(v, n));
-    out
-}
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -925,14 +925,15 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
     LoneSplit { lone, outlines, behind, sorted }
 }
 
-/// `place[s]`: the place among `kept` (places in `m`) of the polygon mapped from scene
-/// polygon `s` (of `sources`), [`NO_ITEM`] for the others; a view maps a polygon at most
-/// once. Written by all threads: a million bisections over the kept polygons' sources, one
-/// for each edge of every whole caster, were a fifth of s3's pass 1 on one thread.
-fn places(m: &Mapped, kept: &[usize], sources: usize) -> Vec<u32> {
+/// `place[s]`: the place among `kept` (indices into `m.polys`) of the polygon mapped from
+/// scene polygon `s` (of the scene's `polygons`), [`NO_ITEM`] for the others; a view maps a
+/// polygon at most once. Written by all threads: three million bisections over the kept
+/// polygons' sources, one for each edge of every whole caster, were a third of s3's lone-sheet
+/// step on one thread.
+fn places(m: &Mapped, kept: &[usize], polygons: usize) -> Vec<u32> {
     use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
     let mut place = Vec::new();
-    place.par_extend((0..sources).into_par_iter().map(|_| AtomicU32::new(NO_ITEM)));
+    place.par_extend((0..polygons).into_par_iter().map(|_| AtomicU32::new(NO_ITEM)));
     kept.par_iter().enumerate().for_each(|(k, &i)| place[m.polys[i].source as usize].store(k as u32, Relaxed));
     place.into_par_iter().map(AtomicU32::into_inner).collect()
 }

@@ -553,7 +553,7 @@ impl SphereGrid {
         // ([`KEY_CHUNK`]) counts their cells and fills its own stretch, and the keys are
         // sorted, all by all threads (a million casters' pairs collected and counted into the
         // cells on one thread were most of the grid's time; a stretch cut for each caster, a
-        // million on one thread, was a tenth of it). Each cell lists its casters in
+        // million on one thread, was a seventh of it). Each cell lists its casters in
         // increasing order.
         let chunks: Vec<&[u32]> = casters.chunks(KEY_CHUNK).collect();
         let counts: Vec<usize> =
