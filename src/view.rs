@@ -286,10 +286,12 @@ impl View {
 
     /// The inverse-depth plane of a world plane; `None` when the eye lies in it (edge-on).
     pub(crate) fn depth_plane(&self, plane: &Plane) -> Option<DepthPlane> {
-        if self.edge_on(plane) {
+        // The eye's distance to the plane, read once: zero when the eye sees it edge-on
+        // ([`View::edge_on`]).
+        let e = plane.distance(self.eye);
+        if e == 0.0 {
             return None;
         }
-        let e = plane.distance(self.eye);
         // 1/z = -(n.f + sx n.r + sy n.u) / e, with sx, sy affine in x, y.
         let k = -1.0 / e;
         let (nr, nu) = (plane.n.dot(self.r) * self.t * self.aspect, plane.n.dot(self.u) * self.t);
