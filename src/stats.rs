@@ -136,6 +136,12 @@ counters! {
     PairsDroppedBehind = "pairs_dropped_behind",
     /// Bouknight-Kelley: kept pairs whose caster's shadow misses the receiver (the wedge test).
     PairsOutsideReceiver = "pairs_outside_receiver",
+    /// Bouknight-Kelley: the (receiver, closed solid) pairs whose shadow polygons were counted
+    /// as the outline of their union.
+    SolidOutlines = "solid_outlines",
+    /// Bouknight-Kelley: kept pairs whose caster was counted in its solid's outline, not
+    /// projected on its own.
+    PairsOutlined = "pairs_outlined",
     /// Bouknight-Kelley: projections that left no shadow polygon on the receiver.
     ProjectionsEmpty = "projections_empty",
     /// Bouknight-Kelley and planar: the shadow polygons made.

@@ -35,8 +35,10 @@
 //! polygons on the far side of the light from B are clipped away by the plane through the
 //! light; zero-area projections are dropped. None of these divide by zero.
 
+use super::far_outline::{self, FarEdge};
 use super::overlay::{Interval, Overlay, OverlayWalker, ReceiverTable};
 use super::projection::{bounding_rectangle, edge_on, faces_away_on_solid, light_side, Projector, Target};
+use super::solid_outlines::{self, SolidOutlines};
 use super::{
     BouknightKelleyOptions, Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker,
 };
@@ -121,6 +123,10 @@ fn shadow_polygons(
     counters.add(crate::stats::Counter::Casters, casters.len() as u64);
     counters.add(crate::stats::Counter::PairsWithRoles, receivers.len() as u64 * casters.len() as u64);
 
+    let outlines = (options.solid_outlines && !ctx.keep_outlines).then(|| {
+        let caster = crate::pieces::marked(n, casters.par_iter().map(|&i| i as usize));
+        SolidOutlines::new(scene, caster, sample, &ctx.pools.stash)
+    });
     let t = Instant::now();
     let extents = options.prefilter.then(|| Extents::new(scene, sample, &casters, &receivers));
     let (grid, extents) = match extents {
@@ -157,7 +163,11 @@ fn shadow_polygons(
                 let prefilter_ns = t.elapsed().as_nanos() as u64;
                 let t = Instant::now();
                 let onto = Onto { ctx, options, sample, b };
-                let (mut tally, table, pairs) = project_onto(onto, candidates, work);
+                let outlined = outlines.as_ref().map_or(Vec::new(), |o| outlined_solids(onto, o, candidates));
+                let (mut tally, table, pairs) = match &outlines {
+                    Some(o) if !outlined.is_empty() => project_counted(onto, o, &outlined, candidates),
+                    _ => project_onto(onto, candidates, work),
+                };
                 tally.tested += tested;
                 tally.prefilter_ns += prefilter_ns;
                 tally.projection_ns += t.elapsed().as_nanos() as u64;
@@ -186,6 +196,10 @@ fn shadow_polygons(
         counters.add(crate::stats::Counter::PairsOutsideReceiver, total.outside);
     }
     counters.add(crate::stats::Counter::ProjectionsEmpty, total.empty);
+    if outlines.is_some() {
+        counters.add(crate::stats::Counter::SolidOutlines, total.outlines);
+        counters.add(crate::stats::Counter::PairsOutlined, total.outlined);
+    }
     counters.add(crate::stats::Counter::ShadowPolygons, overlay.len() as u64);
     counters.add(crate::stats::Counter::PrefilterCpuUs, total.prefilter_ns / 1000);
     counters.add(crate::stats::Counter::ProjectionCpuUs, total.projection_ns / 1000);
@@ -224,6 +238,87 @@ fn project_onto(onto: Onto, candidates: &[u32], work: &mut Workspace) -> (Tally,
     (tally, table, pairs)
 }
 
+/// The solids outlined on the receiver `onto` names (ours, [`solid_outlines`]): of a
+/// receiver with many `candidates`, the solids that give it many and fit between it and the
+/// light, in increasing order.
+fn outlined_solids(onto: Onto, outlines: &SolidOutlines, candidates: &[u32]) -> Vec<u32> {
+    if candidates.len() < solid_outlines::RECEIVER_MIN {
+        return Vec::new();
+    }
+    let Onto { ctx, sample, b, .. } = onto;
+    let scene = ctx.scene;
+    let mut count: FxHashMap<u32, u32> = FxHashMap::default();
+    for &a in candidates {
+        let s = scene.solid_of[a as usize];
+        if (s as usize) < scene.solids.len() {
+            *count.entry(s).or_default() += 1;
+        }
+    }
+    let plane = scene.polygons[b as usize].plane;
+    let target = Target::new(plane, bounding_rectangle(scene.verts(b as usize), &plane), sample);
+    let mut solids: Vec<u32> = count
+        .into_iter()
+        .filter(|&(s, k)| {
+            k >= solid_outlines::PER_SOLID && outlines.fits(scene, s, &target, ctx.view, 1e-9 * ctx.extent)
+        })
+        .map(|(s, _)| s)
+        .collect();
+    solids.sort_unstable();
+    solids
+}
+
+/// Steps 2 and 3 for the receiver `onto` names with the solids `outlined` outlined (ours,
+/// [`solid_outlines`]): their boundaries' edges, and every other candidate's shadow
+/// polygon, counted into one table, their shared edges cancelled. A receiver with more
+/// candidates left than one thread's piece is worked on by all threads, as in
+/// [`project_onto`].
+fn project_counted(
+    onto: Onto,
+    outlines: &SolidOutlines,
+    outlined: &[u32],
+    candidates: &[u32],
+) -> (Tally, ReceiverTable, Pairs) {
+    let Onto { ctx, sample, b, .. } = onto;
+    let (scene, view) = (ctx.scene, ctx.view);
+    let plane = scene.polygons[b as usize].plane;
+    let target = Target::new(plane, bounding_rectangle(scene.verts(b as usize), &plane), sample);
+    // A caster in an outline: on an outlined solid, facing the light.
+    let in_outline =
+        |a: u32| outlined.binary_search(&scene.solid_of[a as usize]).is_ok() && outlines.outlined(scene, a);
+    let rest: Vec<u32> = candidates.iter().copied().filter(|&a| !in_outline(a)).collect();
+    let mut tally = Tally { outlines: outlined.len() as u64, ..Tally::default() };
+    tally.outlined = (candidates.len() - rest.len()) as u64;
+    tally.kept = tally.outlined;
+    let mut edges: Vec<FarEdge> = Vec::new();
+    for &s in outlined {
+        let winding = solid_outlines::winding(view, &target, scene.solids[s as usize].sign);
+        solid_outlines::push_outline(view, &target, outlines.edges(scene, s), winding, &mut edges);
+    }
+    let piece = |work: &mut Workspace, piece: &[u32]| {
+        let mut edges = Vec::new();
+        let mut made = 0u32;
+        let (tally, _) = project_each(onto, piece, work, |ring, a| {
+            let side = sample.side_of(&scene.polygons[a as usize].plane);
+            far_outline::push_ring(ring, solid_outlines::winding(view, &target, side), &mut edges);
+            made += 1;
+        });
+        (tally, edges, made)
+    };
+    let parts: Vec<(Tally, Vec<FarEdge>, u32)> = if rest.len() <= CASTERS_PER_PIECE {
+        vec![piece(&mut Workspace::default(), &rest)]
+    } else {
+        rest.par_chunks(CASTERS_PER_PIECE).map_init(Workspace::default, piece).collect()
+    };
+    let mut count = outlined.len() as u32;
+    for (t, mut e, made) in parts {
+        tally.add(&t);
+        edges.append(&mut e);
+        count += made;
+    }
+    let table = far_outline::table(view.height, &far_outline::cancel(edges));
+    (tally, ReceiverTable::counted(b, table, count), Pairs::default())
+}
+
 /// Whose shadows fall on which receiver: the frame, the stage's switches, the light sample
 /// and receiver `b`.
 #[derive(Clone, Copy)]
@@ -250,11 +345,33 @@ const CASTERS_PER_PIECE: usize = 8192;
 /// Steps 2 and 3 for the receiver `onto` names and the candidates `candidates` (all of them, or a piece),
 /// into an unfinished table.
 fn project_piece(onto: Onto, candidates: &[u32], work: &mut Workspace) -> (Tally, ReceiverTable, Pairs) {
+    let (b, ctx) = (onto.b, onto.ctx);
+    let record = ctx.keep_outlines;
+    let mut table = ReceiverTable::new(b, ctx.view.height, record);
+    let mut made = Vec::new();
+    let (tally, mut pairs) = project_each(onto, candidates, work, |ring, a| {
+        table.add(ring);
+        if record {
+            made.push((0, a));
+        }
+    });
+    pairs.shadow_polygons = made;
+    (tally, table, pairs)
+}
+
+/// Steps 2 and 3 for the receiver `onto` names and the candidates `candidates`: each shadow
+/// polygon made, on screen, goes to `made` with its caster. Returns the tally and (for
+/// traces) the pairs kept and dropped as behind.
+fn project_each(
+    onto: Onto,
+    candidates: &[u32],
+    work: &mut Workspace,
+    mut made: impl FnMut(&[DVec2], u32),
+) -> (Tally, Pairs) {
     let Onto { ctx, options, sample, b } = onto;
     let (scene, record) = (ctx.scene, ctx.keep_outlines);
     let Workspace { proj, scratch, ring } = work;
     let mut tally = Tally::default();
-    let mut table = ReceiverTable::new(b, ctx.view.height, record);
     let mut pairs = Pairs::default();
     let plane = scene.polygons[b as usize].plane;
     let side = light_side(&plane, sample);
@@ -280,13 +397,10 @@ fn project_piece(onto: Onto, candidates: &[u32], work: &mut Workspace) -> (Tally
         } else if !proj.project(a_verts, &target) {
             tally.empty += 1;
         } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
-            table.add(ring);
-            if record {
-                pairs.shadow_polygons.push((0, a));
-            }
+            made(ring, a);
         }
     }
-    (tally, table, pairs)
+    (tally, pairs)
 }
 
 /// Casters whose grid keys one piece of the grid's parallel loop writes.
@@ -350,6 +464,8 @@ fn merge(ctx: &ShadowContext, pieces: Vec<Piece>) -> (Overlay, Tally, FxHashMap<
 #[derive(Default, Clone)]
 struct Tally {
     tested: u64,
+    outlines: u64,
+    outlined: u64,
     kept: u64,
     behind: u64,
     outside: u64,
@@ -361,6 +477,8 @@ struct Tally {
 impl Tally {
     fn add(&mut self, o: &Tally) {
         self.tested += o.tested;
+        self.outlines += o.outlines;
+        self.outlined += o.outlined;
         self.kept += o.kept;
         self.behind += o.behind;
         self.outside += o.outside;

@@ -17,6 +17,7 @@ mod planar;
 mod projection;
 mod ray_cast;
 pub(crate) mod soft_edges;
+mod solid_outlines;
 mod stencil_volume;
 pub(crate) mod volumes;
 mod williams;
@@ -84,6 +85,11 @@ pub struct BouknightKelleyOptions {
     /// is cast by the solid's polygons that face the light. `false` keeps the paper's
     /// casters, to measure the saving.
     pub solid_cull: bool,
+    /// Count the shadow polygons a closed solid casts on a receiver under many of them as
+    /// the outline of their union (default true; ours): the solid's silhouette from the
+    /// light, projected corner by corner, in place of one shadow polygon per polygon facing
+    /// the light. `false` projects each, as the paper does. Traces keep each polygon.
+    pub solid_outlines: bool,
 }
 
 impl BouknightKelleyOptions {
@@ -95,6 +101,7 @@ impl BouknightKelleyOptions {
         drop_behind: true,
         wedge: true,
         solid_cull: true,
+        solid_outlines: true,
     };
 
     /// The paper's method as published: every ordered pair through the sphere prefilter,
@@ -106,6 +113,7 @@ impl BouknightKelleyOptions {
         drop_behind: false,
         wedge: false,
         solid_cull: false,
+        solid_outlines: false,
     };
 }
 
@@ -812,6 +820,7 @@ impl ShadowMethod {
             ShadowMethod::BouknightKelley(o) => {
                 out.push(ShadowMethod::BouknightKelley(BouknightKelleyOptions { prefilter: false, ..*o }));
                 out.push(ShadowMethod::BouknightKelley(BouknightKelleyOptions { solid_cull: false, ..*o }));
+                out.push(ShadowMethod::BouknightKelley(BouknightKelleyOptions { solid_outlines: false, ..*o }));
             }
             ShadowMethod::Crow(v) => {
                 let z_fail = VolumeOptions { counting: volumes::Counting::ZFail, ..*v };
@@ -906,6 +915,7 @@ impl ShadowMethod {
                     on.push((!o.drop_behind, "--no-drop-behind".into()));
                     on.push((!o.wedge, "--no-wedge".into()));
                     on.push((!o.solid_cull, "--no-solid-cull".into()));
+                    on.push((!o.solid_outlines, "--no-solid-outlines".into()));
                 }
             }
             ShadowMethod::AthertonWeilerGreenberg(_) if paper => {}

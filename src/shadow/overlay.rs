@@ -5,7 +5,10 @@
 //!
 //! Each receiver has its own edge table, and its active-edge walk starts on the first line
 //! where a visible run on it asks: for a run on receiver B, the walker gives the pixel
-//! intervals where each of B's overlay polygons covers the run.
+//! intervals where each of B's overlay polygons covers the run. A receiver's polygons may
+//! instead be *counted* (Bouknight-Kelley's solid outlines): their edges carry the weight
+//! their crossing adds to the number of polygons over a point ([`super::far_outline`]), and
+//! the walker gives the intervals where that number is above zero, their union.
 
 use super::{Cover, Decision, Detail, ShadowContext, ShadowWalker};
 use crate::scan::{boundary, ActiveEdges, EdgeTable, OpenSet};
@@ -25,6 +28,8 @@ pub struct Overlay {
     /// For each table, one past the greatest tag its edges carry: a walker keeps the open
     /// polygons of a line in a dense set of that size.
     tags: Vec<u32>,
+    /// For each table, whether it is counted: its edges' tags are crossing weights.
+    counted: Vec<bool>,
     /// What it holds for each receiver, by the receiver's index (as far as the greatest
     /// receiver it holds).
     slot: Vec<Option<Slot>>,
@@ -62,13 +67,28 @@ pub struct ReceiverTable {
     count: u32,
     rings: Vec<Vec<DVec2>>,
     keep_rings: bool,
+    counted: bool,
 }
 
 impl ReceiverTable {
     /// No polygons yet on scene polygon `receiver`, in an image `height` lines high;
     /// `keep_rings` keeps their outlines.
     pub fn new(receiver: u32, height: u32, keep_rings: bool) -> Self {
-        ReceiverTable { receiver, table: EdgeTable::one_frame(height), count: 0, rings: Vec::new(), keep_rings }
+        ReceiverTable {
+            receiver,
+            table: EdgeTable::one_frame(height),
+            count: 0,
+            rings: Vec::new(),
+            keep_rings,
+            counted: false,
+        }
+    }
+
+    /// `count` polygons on scene polygon `receiver`, counted: `table`'s edges are tagged
+    /// with the weights their crossings add to the number of polygons over a point
+    /// ([`super::far_outline::table`]).
+    pub(crate) fn counted(receiver: u32, table: EdgeTable, count: u32) -> Self {
+        ReceiverTable { receiver, table, count, rings: Vec::new(), keep_rings: false, counted: true }
     }
 
     /// Adds a polygon with several rings (holes by the even-odd rule).
@@ -108,7 +128,7 @@ impl ReceiverTable {
             })
             .collect();
         let table = EdgeTable::joined(tables, &tags)?;
-        Some(ReceiverTable { receiver, table, count, rings, keep_rings })
+        Some(ReceiverTable { receiver, table, count, rings, keep_rings, counted: false })
     }
 
     /// The receiver.
@@ -137,6 +157,7 @@ impl Overlay {
             + held(&self.tables)
             + held(&self.base)
             + held(&self.tags)
+            + held(&self.counted)
             + held(&self.slot)
             + rings
     }
@@ -167,6 +188,7 @@ impl Overlay {
             self.tables.push(EdgeTable::new(self.height));
             self.base.push(tag);
             self.tags.push(0);
+            self.counted.push(false);
         }
         self.tags[slot] = self.tags[slot].max(tag - self.base[slot] + 1);
         for ring in rings {
@@ -223,7 +245,8 @@ impl Overlay {
         for (k, t) in tables.iter_mut().enumerate() {
             overlay.slot[t.receiver as usize] = Some(Slot::Table(k as u32));
             overlay.base.push(overlay.count as u32);
-            overlay.tags.push(t.count);
+            overlay.tags.push(if t.counted { 0 } else { t.count });
+            overlay.counted.push(t.counted);
             overlay.count += t.count as usize;
             overlay.rings.append(&mut t.rings);
         }
@@ -328,7 +351,11 @@ impl OverlayWalker<'_> {
         if cached.line != Some(line) {
             let aet = self.active[slot as usize].get_or_insert_with(|| ActiveEdges::new(table, line..end));
             let (base, tags) = (self.overlay.base[slot as usize], self.overlay.tags[slot as usize]);
-            cached.pair(aet.advance_to(line), &mut self.open, base, tags as usize);
+            if self.overlay.counted[slot as usize] {
+                cached.count(aet.advance_to(line), base);
+            } else {
+                cached.pair(aet.advance_to(line), &mut self.open, base, tags as usize);
+            }
             cached.line = Some(line);
         }
         // The intervals starting before the run's end, from the first whose reach passes
@@ -358,6 +385,39 @@ impl LineIntervals {
             }
         }
         self.all.sort_unstable_by_key(|i| (i.start, i.end, i.tag));
+        self.find_reach();
+    }
+
+    /// A counted receiver's line: the crossings (sorted by x, tagged with their weights)
+    /// summed from the left, a pixel's number being the sum of the crossings at or left of
+    /// its centre; the intervals where it is above zero, each tagged `tag`.
+    fn count(&mut self, crossings: &[crate::scan::Crossing], tag: u32) {
+        self.all.clear();
+        let (mut sum, mut open) = (0i32, None);
+        for (k, c) in crossings.iter().enumerate() {
+            sum += c.tag as i32;
+            let at = boundary(c.x, u32::MAX);
+            // The number changes between pixels once all crossings before the same pixel
+            // are summed.
+            if crossings.get(k + 1).is_some_and(|next| boundary(next.x, u32::MAX) == at) {
+                continue;
+            }
+            match open {
+                None if sum > 0 => open = Some(at),
+                Some(start) if sum <= 0 => {
+                    if start < at {
+                        self.all.push(Interval { start, end: at, tag });
+                    }
+                    open = None;
+                }
+                _ => {}
+            }
+        }
+        self.find_reach();
+    }
+
+    /// The furthest end reached at each interval.
+    fn find_reach(&mut self) {
         self.reach.clear();
         let mut far = 0;
         self.reach.extend(self.all.iter().map(|iv| {
@@ -420,5 +480,76 @@ impl ShadowWalker for CoverWalker<'_> {
                 covers: self.intervals.iter().map(|i| Cover { polygon: i.tag, start: i.start, end: i.end }).collect(),
             },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shadow::far_outline;
+
+    /// The intervals a receiver's polygons cover on each line, from the overlay's walker.
+    fn covered(overlay: &Overlay, receiver: u32, lines: u32, width: u32) -> Vec<Vec<(u32, u32)>> {
+        let mut walker = overlay.walker(0..lines);
+        let mut out = Vec::new();
+        (0..lines)
+            .map(|line| {
+                walker.advance_to(line);
+                walker.intervals(receiver, 0, width, &mut out);
+                out.iter().map(|iv| (iv.start, iv.end)).collect()
+            })
+            .collect()
+    }
+
+    /// The pixels of `0..width` that any of a line's `intervals` covers.
+    fn union(intervals: &[(u32, u32)], width: u32) -> Vec<u32> {
+        (0..width).filter(|&x| intervals.iter().any(|&(s, e)| (s..e).contains(&x))).collect()
+    }
+
+    /// A counted receiver covers the union of its polygons, wound alike: shared edges
+    /// cancelled, overlaps counted twice, and polygons wound the other way subtracted.
+    #[test]
+    fn a_counted_receiver_covers_the_union_of_its_polygons() {
+        let p = |x: f64, y: f64| DVec2::new(x, y);
+        // Two triangles making a square (their diagonal shared), a square overlapping it,
+        // and a square apart, all counter-clockwise.
+        let rings = [
+            vec![p(1.0, 1.0), p(9.0, 1.0), p(9.0, 9.0)],
+            vec![p(1.0, 1.0), p(9.0, 9.0), p(1.0, 9.0)],
+            vec![p(5.2, 4.3), p(14.1, 4.3), p(14.1, 12.7), p(5.2, 12.7)],
+            vec![p(17.5, 2.2), p(19.4, 2.2), p(19.4, 6.6), p(17.5, 6.6)],
+        ];
+        let (lines, width) = (14, 24);
+        let mut each = Overlay::new(lines, false);
+        for r in &rings {
+            each.add(0, r);
+        }
+        each.finish();
+        let mut edges = Vec::new();
+        for r in &rings {
+            far_outline::push_ring(r, 1, &mut edges);
+        }
+        let cancelled = far_outline::cancel(edges.clone());
+        assert!(cancelled.len() < edges.len(), "the shared diagonal cancels");
+        let table = far_outline::table(lines, &cancelled);
+        let counted = Overlay::from_tables(lines, false, vec![ReceiverTable::counted(0, table, 4)].into_par_iter());
+        let (by_polygon, by_count) = (covered(&each, 0, lines, width), covered(&counted, 0, lines, width));
+        let mut lit_somewhere = 0;
+        for line in 0..lines as usize {
+            let want = union(&by_polygon[line], width);
+            let got = union(&by_count[line], width);
+            assert_eq!(got, want, "line {line}");
+            // The counted intervals are disjoint, in order.
+            assert!(by_count[line].windows(2).all(|w| w[0].1 < w[1].0), "line {line}: {:?}", by_count[line]);
+            lit_somewhere += want.len();
+        }
+        assert!(lit_somewhere > 100, "{lit_somewhere}");
+        // A ring wound the other way (clockwise: negative shoelace area) takes its part away.
+        let mut holed = cancelled;
+        far_outline::push_ring(&[p(3.1, 3.2), p(3.1, 6.8), p(6.6, 6.8), p(6.6, 3.2)], 1, &mut holed);
+        let table = far_outline::table(lines, &far_outline::cancel(holed));
+        let counted = Overlay::from_tables(lines, false, vec![ReceiverTable::counted(0, table, 5)].into_par_iter());
+        let line5 = union(&covered(&counted, 0, lines, width)[5], width);
+        assert!(!line5.contains(&4) && line5.contains(&2) && line5.contains(&8), "{line5:?}");
     }
 }

@@ -60,9 +60,9 @@ pub struct Target {
     pub plane: Plane,
     /// The rectangle of the plane that the shadows are kept within.
     pub rect: [DVec3; 4],
-    sample: LightSample,
+    pub(crate) sample: LightSample,
     /// [`light_side`] of the plane.
-    side: f64,
+    pub(crate) side: f64,
     /// The faces of the pyramid from the light over `rect`, each as (a point on it, its
     /// inward normal).
     pyramid: [(DVec3, DVec3); 4],

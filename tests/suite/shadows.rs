@@ -429,6 +429,76 @@ fn random_solids_with_lights_inside_on_and_around() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Bouknight-Kelley counts a closed solid's shadow polygons on a receiver under many of
+/// them as the outline of their union (`solid_outlines`): on random floors under spheres
+/// (geodesic and UV, wound either way, some sunk through the floor), lit by point lights
+/// and directional ones from all round, seen from near and far, with the solid cull on and
+/// off, the stage with it equals
+/// ray-cast at every pixel but ties, and equals itself without it; the outlines are at
+/// work on most scenes, and a sphere that reaches the floor's plane, or whose shadow the
+/// camera would cut, is projected polygon by polygon instead.
+#[test]
+fn solid_outlines_count_what_each_polygon_counted() {
+    use rand::{Rng, SeedableRng};
+    use umbra::generate::{geodesic_sphere, sphere_mesh};
+    use umbra::shadow::BouknightKelleyOptions;
+    use umbra::{Camera, Counter, Light, Material, Mesh, Object};
+    let (mut outlined, mut scenes_outlined, mut in_shadow) = (0, 0, 0);
+    for seed in 0..40u64 {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut v = |lo: f64, hi: f64| rng.gen_range(lo..hi);
+        let eye = glam::DVec3::new(v(-6.0, 6.0), v(0.5, 8.0), v(-6.0, 6.0));
+        let mut b = Scene::builder(Camera { width: 96, height: 72, near: 0.05, ..Camera::new(eye, glam::DVec3::ZERO) })
+            .material(Material::new("m"));
+        let floor = vec![vec![
+            glam::DVec3::new(-6.0, 0.0, -6.0),
+            glam::DVec3::new(-6.0, 0.0, 6.0),
+            glam::DVec3::new(6.0, 0.0, 6.0),
+            glam::DVec3::new(6.0, 0.0, -6.0),
+        ]];
+        b = b.object(Object::new(Mesh::from_polygons(&floor)), "m");
+        for k in 0..3 {
+            let r = v(0.3, 0.9);
+            // Most rest above the floor; some sink through its plane.
+            let c = glam::DVec3::new(v(-3.0, 3.0), r * v(0.6, 2.5), v(-3.0, 3.0));
+            let mut mesh = if (seed + k) % 2 == 0 { geodesic_sphere(c, r, 2) } else { sphere_mesh(c, r, 300) };
+            if (seed + k) % 5 == 0 {
+                mesh.faces.iter_mut().for_each(|f| f.vertices.reverse());
+            }
+            b = b.object(Object::new(mesh), "m");
+        }
+        let light = if seed % 4 == 3 {
+            Light::directional(glam::DVec3::new(v(-1.0, 1.0), -1.0, v(-1.0, 1.0)))
+        } else {
+            Light::point(glam::DVec3::new(v(-5.0, 5.0), v(3.0, 9.0), v(-5.0, 5.0)))
+        };
+        let scene = b.light(light).build().unwrap();
+        // With the solid cull off, the spheres' polygons turned from the light cast too.
+        let solid_cull = seed % 3 != 0;
+        let opts = |solid_outlines| umbra::RenderOptions {
+            shadows: ShadowMethod::BouknightKelley(BouknightKelleyOptions {
+                solid_outlines,
+                solid_cull,
+                ..Default::default()
+            }),
+            ..Default::default()
+        };
+        let label = format!("outlines seed {seed}, solid cull {solid_cull}");
+        let (on, off) = (umbra::render(&scene, &opts(true)).unwrap(), umbra::render(&scene, &opts(false)).unwrap());
+        let want = reference(&scene);
+        assert_light_agree(&scene, &want, &on.frame, &format!("{label} with outlines"));
+        assert_light_agree(&scene, &off.frame, &on.frame, &format!("{label} with outlines against without"));
+        let n = on.stats.shadow_counters.get(Counter::SolidOutlines);
+        outlined += n;
+        scenes_outlined += (n > 0) as u32;
+        in_shadow += shadowed(&want);
+        assert_eq!(off.stats.shadow_counters.get(Counter::SolidOutlines), 0, "{label}");
+    }
+    // Three spheres a scene, outlined on the floor at most: some are projected one by one.
+    assert!(scenes_outlined >= 20 && (40..110).contains(&outlined), "{scenes_outlined} scenes, {outlined} outlines");
+    assert!(in_shadow > 40 * 300, "only {in_shadow} pixels in shadow");
+}
+
 /// Random meshes closed but for one or two holes (a box, prism or sphere with faces left
 /// out), lit and seen from all round, so that some lights and eyes see into a hole: every
 /// exact stage equals ray-cast at every pixel but ties, and the solid cull leaves nothing of

@@ -227,6 +227,11 @@ struct ShadowArgs {
     /// as the paper does, instead of dropping them first (ours).
     #[arg(long)]
     no_wedge: bool,
+    /// Bouknight-Kelley: project each polygon of a closed solid onto a receiver under it,
+    /// as the paper does, instead of counting the solid's shadow polygons as the outline of
+    /// their union (ours).
+    #[arg(long)]
+    no_solid_outlines: bool,
     /// Bouknight-Kelley, Atherton-Weiler-Greenberg and Nishita-Nakamae: keep the polygons of
     /// closed solids that face away from the light (as casters; in AWG's light views), as the
     /// papers do (to measure what dropping them saves).
@@ -376,6 +381,7 @@ impl ShadowArgs {
                 drop_behind: !self.no_drop_behind,
                 wedge: !self.no_wedge,
                 solid_cull: !self.no_solid_cull,
+                solid_outlines: !self.no_solid_outlines,
             },
             atherton_weiler_greenberg: self.awg.options(!self.no_solid_cull),
             volumes: VolumeOptions {
