@@ -123,7 +123,9 @@ fn shadow_polygons(
     counters.add(crate::stats::Counter::Casters, casters.len() as u64);
     counters.add(crate::stats::Counter::PairsWithRoles, receivers.len() as u64 * casters.len() as u64);
 
-    let outlines = (options.solid_outlines && !ctx.keep_outlines).then(|| {
+    // Outlines follow the prefilter's candidates: without it every caster is one, and a
+    // receiver would outline every solid whose shadow misses it.
+    let outlines = (options.solid_outlines && options.prefilter && !ctx.keep_outlines).then(|| {
         let caster = crate::pieces::marked(n, casters.par_iter().map(|&i| i as usize));
         SolidOutlines::new(scene, caster, sample, &ctx.pools.stash)
     });
@@ -597,6 +599,7 @@ impl Extents {
     /// <= ah + bh`, that is, the sum below π, where the cosine falls, `ac·bc >= cos(ah +
     /// bh)`, with a hair of slack so that rounding can only keep a pair, never drop one);
     /// for a directional light, their boxes.
+    #[inline(always)]
     fn overlap(&self, a: u32, b: u32) -> bool {
         if self.point() {
             let (ac, bc) = (self.cones[a as usize], self.cones[b as usize]);

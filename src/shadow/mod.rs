@@ -88,7 +88,8 @@ pub struct BouknightKelleyOptions {
     /// Count the shadow polygons a closed solid casts on a receiver under many of them as
     /// the outline of their union (default true; ours): the solid's silhouette from the
     /// light, projected corner by corner, in place of one shadow polygon per polygon facing
-    /// the light. `false` projects each, as the paper does. Traces keep each polygon.
+    /// the light. `false` projects each, as the paper does. Traces keep each polygon; it
+    /// works with the prefilter, whose candidates it counts.
     pub solid_outlines: bool,
 }
 

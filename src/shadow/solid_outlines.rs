@@ -34,7 +34,8 @@
 //! dropped too: their shadows miss the receiver, so they count nowhere on it. Shadow
 //! polygons with no area, which the projection drops, count on no pixel centre but on
 //! their edges (a tie). Traces (which keep each shadow polygon) and the paper path do
-//! without it.
+//! without it, and so does the stage without its prefilter, where every caster is a
+//! candidate of every receiver.
 
 use super::far_outline::{self, FarEdge};
 use super::projection::Target;
