@@ -125,10 +125,8 @@ fn shadow_polygons(
 
     // Outlines follow the prefilter's candidates: without it every caster is one, and a
     // receiver would outline every solid whose shadow misses it.
-    let outlines = (options.solid_outlines && options.prefilter && !ctx.keep_outlines).then(|| {
-        let caster = crate::pieces::marked(n, casters.par_iter().map(|&i| i as usize));
-        SolidOutlines::new(scene, caster, sample, &ctx.pools.stash)
-    });
+    let outlines = (options.solid_outlines && options.prefilter && !ctx.keep_outlines)
+        .then(|| SolidOutlines::new(scene, &casters, sample, &ctx.pools.stash));
     let t = Instant::now();
     let extents = options.prefilter.then(|| Extents::new(scene, sample, &casters, &receivers));
     let (grid, extents) = match extents {
@@ -285,17 +283,22 @@ fn project_counted(
     let plane = scene.polygons[b as usize].plane;
     let target = Target::new(plane, bounding_rectangle(scene.verts(b as usize), &plane), sample);
     // A caster in an outline: on an outlined solid, facing the light.
-    let in_outline =
-        |a: u32| outlined.binary_search(&scene.solid_of[a as usize]).is_ok() && outlines.outlined(scene, a);
+    let in_outline = |a: u32| outlined.binary_search(&scene.solid_of[a as usize]).is_ok() && outlines.outlined(a);
     let rest: Vec<u32> = candidates.iter().copied().filter(|&a| !in_outline(a)).collect();
     let mut tally = Tally { outlines: outlined.len() as u64, ..Tally::default() };
     tally.outlined = (candidates.len() - rest.len()) as u64;
     tally.kept = tally.outlined;
-    let mut edges: Vec<FarEdge> = Vec::new();
-    for &s in outlined {
-        let winding = solid_outlines::winding(view, &target, scene.solids[s as usize].sign);
-        solid_outlines::push_outline(view, &target, outlines.edges(scene, s), winding, &mut edges);
-    }
+    // Each solid's outline on its own, by all threads (the first receiver to ask finds a
+    // solid's boundary: a pass over its polygons).
+    let mut edges: Vec<FarEdge> = outlined
+        .par_iter()
+        .flat_map_iter(|&s| {
+            let winding = solid_outlines::winding(view, &target, scene.solids[s as usize].sign);
+            let mut edges = Vec::new();
+            solid_outlines::push_outline(view, &target, outlines.edges(scene, s), winding, &mut edges);
+            edges
+        })
+        .collect();
     let piece = |work: &mut Workspace, piece: &[u32]| {
         let mut edges = Vec::new();
         let mut made = 0u32;

@@ -43,6 +43,7 @@ use crate::pool::Stash;
 use crate::scene::{LightSample, Scene};
 use crate::view::View;
 use glam::{DVec2, DVec3, DVec4};
+use rayon::prelude::*;
 use std::sync::{Arc, OnceLock};
 
 /// The fewest candidates a receiver must have before its solids are looked at.
@@ -54,9 +55,9 @@ pub(crate) const PER_SOLID: u32 = 64;
 /// One light sample's solid outlines: which polygons cast, and each solid's boundary edges,
 /// found the first time a receiver asks.
 pub(crate) struct SolidOutlines {
-    /// `caster[i]`: polygon `i` casts shadows for this sample.
-    caster: Vec<bool>,
-    sample: LightSample,
+    /// `outlined[i]`: polygon `i` casts shadows for this sample and faces the light from its
+    /// closed solid's outside (one its solid's outline counts).
+    outlined: Vec<bool>,
     /// Each solid's polygons.
     members: Arc<Vec<Vec<u32>>>,
     /// Each solid's boundary edges between a caster and a polygon that is not one, each
@@ -69,23 +70,26 @@ type KeptMembers = (u64, Arc<Vec<Vec<u32>>>);
 
 impl SolidOutlines {
     /// The outlines of `scene`'s solids for light sample `sample`, whose casters are
-    /// `caster`.
-    pub(crate) fn new(scene: &Scene, caster: Vec<bool>, sample: LightSample, kept: &Stash) -> Self {
+    /// `casters`.
+    pub(crate) fn new(scene: &Scene, casters: &[u32], sample: LightSample, kept: &Stash) -> Self {
         let id = scene.polygons_id;
         let members = kept.find_or_make::<KeptMembers>(|k| k.0 == id, || (id, Arc::new(members(scene))), 4).1;
         let edges = (0..scene.solids.len()).map(|_| OnceLock::new()).collect();
-        SolidOutlines { caster, sample, members, edges }
+        let facing = |i: u32| {
+            let solid = scene.solids.get(scene.solid_of[i as usize] as usize);
+            solid.is_some_and(|solid| solid.sign * sample.side_of(&scene.polygons[i as usize].plane) > 0.0)
+        };
+        let outlined = crate::pieces::marked(
+            scene.polygons.len(),
+            casters.par_iter().filter(|&&i| facing(i)).map(|&i| i as usize),
+        );
+        SolidOutlines { outlined, members, edges }
     }
 
     /// Whether polygon `i` casts and faces the light from its closed solid's outside: one
     /// its solid's outline counts.
-    pub(crate) fn outlined(&self, scene: &Scene, i: u32) -> bool {
-        let s = scene.solid_of[i as usize] as usize;
-        self.caster.get(i as usize).copied().unwrap_or(false)
-            && scene
-                .solids
-                .get(s)
-                .is_some_and(|solid| solid.sign * self.sample.side_of(&scene.polygons[i as usize].plane) > 0.0)
+    pub(crate) fn outlined(&self, i: u32) -> bool {
+        self.outlined.get(i as usize).copied().unwrap_or(false)
     }
 
     /// Solid `s`'s boundary edges (step 2).
@@ -93,12 +97,12 @@ impl SolidOutlines {
         self.edges[s as usize].get_or_init(|| {
             let mut out = Vec::new();
             for &i in &self.members[s as usize] {
-                if !self.outlined(scene, i) {
+                if !self.outlined(i) {
                     continue;
                 }
                 let verts = scene.verts(i as usize);
                 for (k, &g) in scene.across(i as usize).iter().enumerate() {
-                    if !self.outlined(scene, g) {
+                    if !self.outlined(g) {
                         out.push([verts[k], verts[(k + 1) % verts.len()]]);
                     }
                 }
