@@ -245,8 +245,7 @@ fn outlined_solids(onto: Onto, outlines: &SolidOutlines, candidates: &[u32]) -> 
     if candidates.len() < solid_outlines::RECEIVER_MIN {
         return Vec::new();
     }
-    let Onto { ctx, sample, b, .. } = onto;
-    let scene = ctx.scene;
+    let (ctx, scene) = (onto.ctx, onto.ctx.scene);
     let mut count: FxHashMap<u32, u32> = FxHashMap::default();
     for &a in candidates {
         let s = scene.solid_of[a as usize];
@@ -254,8 +253,7 @@ fn outlined_solids(onto: Onto, outlines: &SolidOutlines, candidates: &[u32]) -> 
             *count.entry(s).or_default() += 1;
         }
     }
-    let plane = scene.polygons[b as usize].plane;
-    let target = Target::new(plane, bounding_rectangle(scene.verts(b as usize), &plane), sample);
+    let target = onto.target();
     let mut solids: Vec<u32> = count
         .into_iter()
         .filter(|&(s, k)| {
@@ -279,9 +277,7 @@ fn project_counted(
     candidates: &[u32],
 ) -> (Tally, ReceiverTable, Pairs) {
     let Onto { ctx, sample, b, .. } = onto;
-    let (scene, view) = (ctx.scene, ctx.view);
-    let plane = scene.polygons[b as usize].plane;
-    let target = Target::new(plane, bounding_rectangle(scene.verts(b as usize), &plane), sample);
+    let (scene, view, target) = (ctx.scene, ctx.view, onto.target());
     // A caster in an outline: on an outlined solid, facing the light.
     let in_outline = |a: u32| outlined.binary_search(&scene.solid_of[a as usize]).is_ok() && outlines.outlined(a);
     let rest: Vec<u32> = candidates.iter().copied().filter(|&a| !in_outline(a)).collect();
@@ -334,6 +330,14 @@ struct Onto<'c> {
     b: u32,
 }
 
+impl Onto<'_> {
+    /// Receiver `b`'s plane, within its bounding rectangle, lit by the sample.
+    fn target(&self) -> Target {
+        let plane = self.ctx.scene.polygons[self.b as usize].plane;
+        Target::new(plane, bounding_rectangle(self.ctx.scene.verts(self.b as usize), &plane), self.sample)
+    }
+}
+
 /// One thread's scratch for projecting casters: the projector, the clipper's buffers and
 /// the screen ring.
 #[derive(Default)]
@@ -381,7 +385,7 @@ fn project_each(
     let plane = scene.polygons[b as usize].plane;
     let side = light_side(&plane, sample);
     let b_verts = scene.verts(b as usize);
-    let target = Target::new(plane, bounding_rectangle(b_verts, &plane), sample);
+    let target = onto.target();
     let wedge = if options.wedge { Wedge::of(b_verts, sample, ctx.extent) } else { None };
     for &a in candidates {
         if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
