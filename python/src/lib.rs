@@ -143,7 +143,7 @@ fn named<T: std::str::FromStr<Err = um::Error>>(v: &Bound<'_, PyAny>) -> PyResul
 }
 
 /// Every keyword setting [`stage_settings`] knows, by name.
-const SETTINGS: [(&str, Setter); 29] = [
+const SETTINGS: [(&str, Setter); 30] = [
     ("prefilter", |s, v| v.extract().map(|x| s.bouknight_kelley.prefilter = x)),
     ("sphere_grid", |s, v| v.extract().map(|x| s.bouknight_kelley.sphere_grid = x)),
     ("seen_receivers", |s, v| v.extract().map(|x| s.bouknight_kelley.seen_receivers = x)),
@@ -167,6 +167,7 @@ const SETTINGS: [(&str, Setter); 29] = [
     ("construction", |s, v| named(v).map(|x| s.volumes.construction = x)),
     ("sight_cuts", |s, v| v.extract().map(|x| s.volumes.sight_cuts = x)),
     ("far_outline", |s, v| v.extract().map(|x| s.volumes.far_outline = x)),
+    ("front_outline", |s, v| v.extract().map(|x| s.volumes.front_outline = x)),
     ("map_size", |s, v| v.extract().map(|x| s.williams.map_size = x)),
     ("bias", |s, v| v.extract().map(|x| s.williams.bias = x)),
     ("slope_bias", |s, v| v.extract().map(|x| s.williams.slope_bias = x)),

@@ -251,6 +251,12 @@ pub struct VolumeOptions {
     /// left instead of each cap (`docs/algorithms/crow.md`). `false` counts each far cap as a
     /// shadow polygon of its own.
     pub far_outline: bool,
+    /// Count z-fail's front caps as the outline of their union too (default true; ours;
+    /// with the far outline): a front cap is a scene polygon, never in front of the visible
+    /// point, so z-fail counts it wherever it covers the pixel, whatever the depth, and the
+    /// caps' shared edges cancel (`docs/algorithms/crow.md`). `false` counts each front cap
+    /// as a shadow polygon with its depth.
+    pub front_outline: bool,
 }
 
 impl VolumeOptions {
@@ -260,6 +266,7 @@ impl VolumeOptions {
         construction: Construction::Merged,
         sight_cuts: true,
         far_outline: true,
+        front_outline: true,
     };
 
     /// Crow's 1977 construction counted by z-pass, uncut: the paper as published.
@@ -268,6 +275,7 @@ impl VolumeOptions {
         construction: Construction::Crow1977,
         sight_cuts: false,
         far_outline: false,
+        front_outline: false,
     };
 }
 
@@ -827,6 +835,7 @@ impl ShadowMethod {
                 let z_fail = VolumeOptions { counting: volumes::Counting::ZFail, ..*v };
                 out.push(ShadowMethod::Crow(z_fail));
                 out.push(ShadowMethod::Crow(VolumeOptions { far_outline: false, ..z_fail }));
+                out.push(ShadowMethod::Crow(VolumeOptions { front_outline: false, ..z_fail }));
                 out.push(ShadowMethod::Crow(VolumeOptions { sight_cuts: false, ..*v }));
                 out.push(ShadowMethod::Crow(VolumeOptions { counting: volumes::Counting::NaiveZPass, ..*v }));
             }
@@ -834,6 +843,7 @@ impl ShadowMethod {
                 let z_fail = VolumeOptions { counting: volumes::Counting::ZFail, ..*v };
                 out.push(ShadowMethod::StencilVolume(z_fail));
                 out.push(ShadowMethod::StencilVolume(VolumeOptions { far_outline: false, ..z_fail }));
+                out.push(ShadowMethod::StencilVolume(VolumeOptions { front_outline: false, ..z_fail }));
             }
             ShadowMethod::NishitaNakamae(o) => {
                 // Each step that buys speed off by itself (the premise's fallback is what
@@ -936,6 +946,7 @@ impl ShadowMethod {
                     on.push((construction, format!("--volumes {}", v.construction.name())));
                     on.push((!v.sight_cuts, "--no-sight-cuts".into()));
                     on.push((!v.far_outline, "--no-far-outline".into()));
+                    on.push((v.far_outline && !v.front_outline, "--no-front-outline".into()));
                 }
             }
             ShadowMethod::Williams(o) => on.extend(o.flags().into_iter().map(|f| (true, f))),

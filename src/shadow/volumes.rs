@@ -145,10 +145,11 @@ fn shadow_polygons(
     sample: LightSample,
     counting: Counting,
     far: Option<&FarPlane>,
-    far_outline: bool,
+    (far_outline, front_outline): (bool, bool),
     camera: &Camera,
 ) -> Vec<Piece> {
     let far_outline = far_outline && far.is_some();
+    let front_outline = far_outline && front_outline;
     let b = Builder::new(ctx, sample, counting, far);
     // With merged volumes, a closed solid's polygons turned away from the light are left out
     // (ours): every shadow ray crossing one has crossed, nearer the light, one of the same
@@ -182,6 +183,10 @@ fn shadow_polygons(
     // step 2b; any other far cap leaves its edges.
     let wound: Vec<AtomicI8> =
         (0..if far_outline { ctx.scene.polygons.len() } else { 0 }).map(|_| AtomicI8::new(0)).collect();
+    // The same for the front caps (ours, `front_outline`): a front cap whole on screen leaves
+    // the times it winds for the edges' pass.
+    let front_wound: Vec<AtomicI8> =
+        (0..if front_outline { ctx.scene.polygons.len() } else { 0 }).map(|_| AtomicI8::new(0)).collect();
     let caps = adjacency.merged.par_chunks(PIECE).map_init(
         || (Scratch::default(), Projector::default()),
         |(scratch, proj), polys| {
@@ -194,7 +199,15 @@ fn shadow_polygons(
                     }
                     continue;
                 }
-                piece.add(camera, scratch, Some(b.front_cap(verts, p as usize, None)));
+                let front = b.front_cap(verts, p as usize, None);
+                match front_outline {
+                    true => {
+                        if let Some(w) = piece.add_front(camera, scratch, front, verts) {
+                            front_wound[p as usize].store(w, Ordering::Relaxed);
+                        }
+                    }
+                    false => piece.add(camera, scratch, Some(front)),
+                }
                 if let Some(w) = piece.add_far(camera, scratch, &b, proj, verts) {
                     wound[p as usize].store(w, Ordering::Relaxed);
                 }
@@ -213,9 +226,18 @@ fn shadow_polygons(
                 let way =
                     |s: &Sharing| i32::from(wound[s.poly()].load(Ordering::Relaxed)) * if s.forward() { 1 } else { -1 };
                 let runs: i32 = sharing.iter().map(way).sum();
+                let (ea, eb) = e.ends(ctx.scene);
                 if runs != 0 {
-                    let (ea, eb) = e.ends(ctx.scene);
                     piece.far.push(FarEdge::run(b.far_image(far, ea), b.far_image(far, eb), runs));
+                }
+                if front_outline {
+                    let way = |s: &Sharing| {
+                        i32::from(front_wound[s.poly()].load(Ordering::Relaxed)) * if s.forward() { 1 } else { -1 }
+                    };
+                    let runs: i32 = sharing.iter().map(way).sum();
+                    if runs != 0 {
+                        piece.far.push(FarEdge::run(b.front_image(ea), b.front_image(eb), runs));
+                    }
                 }
             }
             piece
@@ -392,6 +414,41 @@ impl Piece {
         }
     }
 
+    /// Puts front cap `front` through `camera` for the outline of the caps' union (ours,
+    /// `front_outline`): a front cap is a scene polygon, so on screen it never lies in front
+    /// of the visible point (a polygon nearer would be the one seen), and z-fail counts it,
+    /// with the opposite of its sign, at every pixel it covers, its own polygon's included
+    /// (`ScreenShadowPolygon::count_at`). Its screen edges go with the far caps', wound so
+    /// that its inside winds that many times: the way its corners run on screen is the way
+    /// its plane faces the eye ([`far_outline::facing`]), times the way its corners `verts`
+    /// run round the plane's normal (its Newell normal's side: a reflected scene's polygons
+    /// run the other way round their planes).
+    /// A cap whole on screen (found from its corners first, as a far cap is) leaves only the
+    /// times it winds, returned, for the edges' pass.
+    fn add_front(
+        &mut self,
+        camera: &Camera,
+        scratch: &mut Scratch,
+        front: ShadowPolygon,
+        verts: &[DVec3],
+    ) -> Option<i8> {
+        self.made[front.part as usize] += 1;
+        let wound = front.plane.map_or(0, |plane| {
+            far_outline::wound(newell_normal(verts), &plane, far_outline::facing(camera.view, &plane))
+        });
+        let winding = -front.sign * wound;
+        if winding != 0 && camera.view.whole_on_screen(front.verts.iter().copied()) {
+            return Some(winding as i8);
+        }
+        match scratch.screen(camera, &front) {
+            Screened::On(_) if scratch.whole => return Some(winding as i8),
+            Screened::On(_) => far_outline::push_ring(&scratch.ring, winding, &mut self.far),
+            Screened::OutOfSight => self.outside += 1,
+            Screened::Off => {}
+        }
+        None
+    }
+
     /// Makes the far cap of polygon `verts` (`b` has the far plane; `proj` is scratch) and
     /// puts it through `camera`, for the far outline. A cap whole on screen too gives the way
     /// it winds (+1: counter-clockwise), and its edges are left to the edges' pass; any other
@@ -462,6 +519,13 @@ impl<'c> Builder<'c> {
     fn far_image(&self, far: &Target, v: DVec3) -> DVec2 {
         let view = self.ctx.view;
         view.project(view.homogeneous_in_camera(finite(far.onto(v))).truncate())
+    }
+
+    /// Corner `v`'s image on screen as a front cap whole on screen has it: put through the
+    /// camera alone (the same steps, so the same bits).
+    fn front_image(&self, v: DVec3) -> DVec2 {
+        let view = self.ctx.view;
+        view.project(view.homogeneous_in_camera(finite(v)).truncate())
     }
 
     /// The normal of the plane through edge `a → b` and the light (not normalised; zero when
@@ -1107,7 +1171,10 @@ impl ScreenVolumes {
         let camera = Camera { view, hull, far_clip };
         let pieces = match options.construction {
             super::Construction::Crow1977 => crow_1977(ctx, adjacency, sample, counting, &camera),
-            _ => shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), options.far_outline, &camera),
+            _ => {
+                let outlines = (options.far_outline, options.front_outline);
+                shadow_polygons(ctx, adjacency, sample, counting, far.as_ref(), outlines, &camera)
+            }
         };
         let eye_count = pieces.iter().map(|p| p.eye_count).sum::<i32>();
         if options.construction == super::Construction::Crow1977 && counting == Counting::ZPass {

@@ -286,6 +286,11 @@ struct ShadowArgs {
     /// own (ours: the far caps counted as the outline of their union).
     #[arg(long)]
     no_far_outline: bool,
+    /// Crow and stencil-volume with z-fail: count each front cap as a shadow polygon with
+    /// its depth (ours: the front caps counted with the far caps, as the outline of their
+    /// union).
+    #[arg(long)]
+    no_front_outline: bool,
     /// Williams: texels along each side of a shadow map.
     #[arg(long, default_value_t = 2048)]
     map_size: u32,
@@ -389,6 +394,7 @@ impl ShadowArgs {
                 construction,
                 sight_cuts: !self.no_sight_cuts,
                 far_outline: !self.no_far_outline,
+                front_outline: !self.no_front_outline,
             },
             williams: WilliamsOptions {
                 map_size: self.map_size,
