@@ -887,6 +887,17 @@ impl Scene {
         &self.vertices[p.start as usize..(p.start + p.len) as usize]
     }
 
+    /// Each closed solid's polygons, in increasing order (`members[s]` for solid `s`).
+    pub(crate) fn solid_members(&self) -> Vec<Vec<u32>> {
+        let mut members: Vec<Vec<u32>> = vec![Vec::new(); self.solids.len()];
+        for (i, &s) in self.solid_of.iter().enumerate() {
+            if let Some(m) = members.get_mut(s as usize) {
+                m.push(i as u32);
+            }
+        }
+        members
+    }
+
     /// `closed[s]`: whether solid `s` is closed as seen from `from` (a light sample or the
     /// eye), which lies outside its bounds. [`Scene::turned_away_on_solid`] needs it.
     pub(crate) fn closed_from(&self, from: LightSample) -> Vec<bool> {

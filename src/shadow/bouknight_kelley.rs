@@ -42,7 +42,7 @@ use super::solid_outlines::{self, SolidOutlines};
 use super::{
     BouknightKelleyOptions, Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker,
 };
-use crate::geometry::grid_rectangle;
+use crate::geometry::{grid_rectangle, newell_normal};
 use crate::pool::Pool;
 use crate::scene::{LightSample, Scene};
 use crate::stats::Counters;
@@ -299,7 +299,10 @@ fn project_counted(
         let mut edges = Vec::new();
         let mut made = 0u32;
         let (tally, _) = project_each(onto, piece, work, |ring, a| {
-            let side = sample.side_of(&scene.polygons[a as usize].plane);
+            // The caster's side of the light, taken round the way its corners run (as the
+            // front outline takes it: a reflected scene's corners run against their plane).
+            let plane = &scene.polygons[a as usize].plane;
+            let side = sample.side_of(plane) * newell_normal(scene.verts(a as usize)).dot(plane.n).signum();
             far_outline::push_ring(ring, solid_outlines::winding(view, &target, side), &mut edges);
             made += 1;
         });

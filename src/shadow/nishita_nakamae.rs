@@ -191,24 +191,21 @@ fn body_shadows(bodies: &mut Vec<(u32, Vec<DVec2>)>, solid: u32, shadow: Vec<DVe
 /// `convex[s]`: whether solid `s` of `scene` is convex (every vertex of it on or behind the
 /// plane of each of its polygons, to a relative 1e-9 of the scene's size), found in parallel.
 fn convex_solids(scene: &Scene, extent: f64) -> Vec<bool> {
-    let mut members: Vec<Vec<usize>> = vec![Vec::new(); scene.solids.len()];
-    for (i, &s) in scene.solid_of.iter().enumerate() {
-        if let Some(m) = members.get_mut(s as usize) {
-            m.push(i);
-        }
-    }
-    members
+    scene
+        .solid_members()
         .par_iter()
         .zip(&scene.solids)
         .map(|(polys, solid)| {
             // Each corner once (a vertex is shared by several polygons).
-            let mut verts: Vec<[u64; 3]> =
-                polys.iter().flat_map(|&i| scene.verts(i).iter().map(|v| v.to_array().map(f64::to_bits))).collect();
+            let mut verts: Vec<[u64; 3]> = polys
+                .iter()
+                .flat_map(|&i| scene.verts(i as usize).iter().map(|v| v.to_array().map(f64::to_bits)))
+                .collect();
             verts.sort_unstable();
             verts.dedup();
             let verts: Vec<DVec3> = verts.into_iter().map(|v| DVec3::from_array(v.map(f64::from_bits))).collect();
             polys.iter().all(|&i| {
-                let plane = &scene.polygons[i].plane;
+                let plane = &scene.polygons[i as usize].plane;
                 verts.iter().all(|&v| solid.sign * plane.distance(v) <= 1e-9 * extent)
             })
         })

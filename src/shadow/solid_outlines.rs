@@ -73,7 +73,7 @@ impl SolidOutlines {
     /// `casters`.
     pub(crate) fn new(scene: &Scene, casters: &[u32], sample: LightSample, kept: &Stash) -> Self {
         let id = scene.polygons_id;
-        let members = kept.find_or_make::<KeptMembers>(|k| k.0 == id, || (id, Arc::new(members(scene))), 4).1;
+        let members = kept.find_or_make::<KeptMembers>(|k| k.0 == id, || (id, Arc::new(scene.solid_members())), 4).1;
         let edges = (0..scene.solids.len()).map(|_| OnceLock::new()).collect();
         let facing = |i: u32| {
             let solid = scene.solids.get(scene.solid_of[i as usize] as usize);
@@ -133,17 +133,6 @@ impl SolidOutlines {
         });
         between && view.whole_on_screen(corners.iter().map(|&c| target.onto(c).extend(1.0)))
     }
-}
-
-/// Each solid's polygons, in order.
-fn members(scene: &Scene) -> Vec<Vec<u32>> {
-    let mut members: Vec<Vec<u32>> = vec![Vec::new(); scene.solids.len()];
-    for (i, &s) in scene.solid_of.iter().enumerate() {
-        if let Some(m) = members.get_mut(s as usize) {
-            m.push(i as u32);
-        }
-    }
-    members
 }
 
 /// A point of the receiver's plane on screen, put through the camera on its own.

@@ -223,21 +223,22 @@ fn shadow_polygons(
         let edges = adjacency.edge_pieces().map(|edges| {
             let mut piece = Piece::default();
             for (e, sharing) in edges {
-                let way =
-                    |s: &Sharing| i32::from(wound[s.poly()].load(Ordering::Relaxed)) * if s.forward() { 1 } else { -1 };
-                let runs: i32 = sharing.iter().map(way).sum();
-                let (ea, eb) = e.ends(ctx.scene);
-                if runs != 0 {
-                    piece.far.push(FarEdge::run(b.far_image(far, ea), b.far_image(far, eb), runs));
+                // The times the whole caps of `wound` run the edge, each the way its polygon
+                // runs it (the front caps' list is empty without their outline).
+                let runs = |wound: &[AtomicI8]| -> i32 {
+                    let way = |s: &Sharing| wound.get(s.poly()).map_or(0, |w| i32::from(w.load(Ordering::Relaxed)));
+                    sharing.iter().map(|s| way(s) * if s.forward() { 1 } else { -1 }).sum()
+                };
+                let (far_runs, front_runs) = (runs(&wound), runs(&front_wound));
+                if far_runs == 0 && front_runs == 0 {
+                    continue;
                 }
-                if front_outline {
-                    let way = |s: &Sharing| {
-                        i32::from(front_wound[s.poly()].load(Ordering::Relaxed)) * if s.forward() { 1 } else { -1 }
-                    };
-                    let runs: i32 = sharing.iter().map(way).sum();
-                    if runs != 0 {
-                        piece.far.push(FarEdge::run(b.front_image(ea), b.front_image(eb), runs));
-                    }
+                let (ea, eb) = e.ends(ctx.scene);
+                if far_runs != 0 {
+                    piece.far.push(FarEdge::run(b.far_image(far, ea), b.far_image(far, eb), far_runs));
+                }
+                if front_runs != 0 {
+                    piece.far.push(FarEdge::run(b.front_image(ea), b.front_image(eb), front_runs));
                 }
             }
             piece
