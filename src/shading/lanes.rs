@@ -158,6 +158,23 @@ fn flat_mut(v: &mut [f32x8]) -> &mut [f32] {
     wide::bytemuck::cast_slice_mut(v)
 }
 
+/// Writes the eight values of `x` to `v` from `at`: the values past the pixels meant are
+/// scratch, written again by what follows them along the line (ours: one store, not a
+/// loop over the pixels meant; the line's arrays have a group to spare at the end).
+#[inline(always)]
+fn store_wide(v: &mut [f32], at: usize, x: f32x8) {
+    v[at..at + W].copy_from_slice(&x.to_array());
+}
+
+/// Writes `x` to `v` in `from..to`, and as scratch up to seven values past it
+/// ([`store_wide`]).
+#[inline(always)]
+fn fill_wide(v: &mut [f32], from: usize, to: usize, x: f32) {
+    for at in (from..to).step_by(W) {
+        store_wide(v, at, f32x8::splat(x));
+    }
+}
+
 /// Writes the first `n` of the eight values of `x` to `v` from `at`.
 #[inline(always)]
 fn store(v: &mut [f32], at: usize, n: usize, x: f32x8) {
@@ -198,7 +215,8 @@ impl LineLanes {
         self.width = width;
         self.padded = width.div_ceil(W) * W;
         for v in self.acc.iter_mut().chain(&mut self.q).chain(&mut self.normal) {
-            v.resize(self.padded / W, f32x8::ZERO);
+            // A group to spare for the scratch of [`store_wide`].
+            v.resize(self.padded / W + 1, f32x8::ZERO);
         }
         self.stretches.clear();
         (self.background, self.claimed) = (background, 0);
@@ -209,7 +227,7 @@ impl LineLanes {
     pub fn start_run(&mut self, x0: usize, x1: usize, ambient: Vec3) {
         self.background_to(x0);
         for (c, v) in self.acc.iter_mut().enumerate() {
-            flat_mut(v)[x0..x1].fill(ambient[c]);
+            fill_wide(flat_mut(v), x0, x1, ambient[c]);
         }
         self.claimed = x1;
     }
@@ -218,7 +236,7 @@ impl LineLanes {
     fn background_to(&mut self, x: usize) {
         let from = self.claimed.min(x);
         for (c, v) in self.acc.iter_mut().enumerate() {
-            flat_mut(v)[from..x].fill(self.background[c]);
+            fill_wide(flat_mut(v), from, x, self.background[c]);
         }
     }
 
@@ -267,12 +285,12 @@ impl LineLanes {
         let (depth, den) = (f32x8::splat(g.depth), g.den.map(f32x8::splat));
         let (n0, n1, plane) = (splat(g.normal[0]), splat(g.normal[1]), splat(g.plane));
         for group in 0..len.div_ceil(W) {
-            let (i, at, n) = (index(group), x0 + W * group, (len - W * group).min(W));
+            let (i, at) = (index(group), x0 + W * group);
             let t = depth / i.mul_add(den[1], den[0]);
             let normal = normalize([0, 1, 2].map(|c| i.mul_add(n1[c], n0[c])), &plane);
             for c in 0..3 {
-                store(flat_mut(&mut self.q[c]), at, n, i.mul_add(step[c], ray[c]) * t);
-                store(flat_mut(&mut self.normal[c]), at, n, normal[c]);
+                store_wide(flat_mut(&mut self.q[c]), at, i.mul_add(step[c], ray[c]) * t);
+                store_wide(flat_mut(&mut self.normal[c]), at, normal[c]);
             }
         }
         match self.stretches.last_mut() {

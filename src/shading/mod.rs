@@ -174,10 +174,10 @@ struct Term {
 pub(crate) struct LineShading {
     lanes: LineLanes,
     run: RunShading,
-    /// The corners and vertex normals of each run's triangle (zero for other polygons),
-    /// gathered for the whole line before its first run is shaded (ours): the runs' reads,
-    /// independent of one another, then wait on memory together, not one run after another
-    /// (a line of s3 meets some five hundred triangles, most of them for the first time).
+    /// Each run's [`Shader::triangle`] (zero for other polygons), made for the whole line
+    /// before its first run is shaded (ours): the runs' reads, independent of one another,
+    /// then wait on memory together, not one run after another (a line of s3 meets some
+    /// five hundred triangles, most of them for the first time).
     triangles: Vec<[DVec3; 6]>,
     /// Every run on the f64 path (the tests compare the two paths with it).
     f64_only: bool,
@@ -203,8 +203,8 @@ struct RunShading {
     /// where the polygon meets the scan plane.
     crossings: Vec<ScanCrossing>,
     along: DVec3,
-    /// The run's triangle's corners and vertex normals (zero for other polygons).
-    triangle: [DVec3; 6],
+    /// The signed distance of the eye from the run's plane.
+    eye_distance: f64,
     /// The larger `|p - eye|` of the run's ends (for runs in lanes), the ray through its
     /// first pixel, and its plane's `depth` and `den` (see [`lanes`]).
     reach: f64,
@@ -316,7 +316,6 @@ impl<'a> Shader<'a> {
             let (x0, x1) = (run.x0 as usize, run.x1 as usize);
             let lit = |k: usize| &lit[k * width + x0..k * width + x1];
             self.begin_run(run, rs);
-            rs.triangle = *triangle;
             ls.lanes.start_run(x0, x1, self.ambient(rs.poly));
             let in_lanes = match self.scene.material(rs.poly).shading {
                 ShadingMode::Flat => {
@@ -324,7 +323,7 @@ impl<'a> Shader<'a> {
                     continue;
                 }
                 ShadingMode::Gouraud => self.gouraud_run(rs, &mut ls.lanes, ls.f64_only, lit),
-                ShadingMode::Phong => self.phong_run(rs, &mut ls.lanes, ls.f64_only, lit),
+                ShadingMode::Phong => self.phong_run(rs, triangle, &mut ls.lanes, ls.f64_only, lit),
             };
             *(if in_lanes { &mut ls.runs_in_lanes } else { &mut ls.runs_in_f64 }) += 1;
         }
@@ -337,7 +336,8 @@ impl<'a> Shader<'a> {
         let poly = run.poly as usize;
         let plane = &self.scene.polygons[poly].plane;
         rs.poly = poly;
-        rs.flip = if plane.distance(self.view.eye) >= 0.0 { 1.0 } else { -1.0 };
+        rs.eye_distance = plane.distance(self.view.eye);
+        rs.flip = if rs.eye_distance >= 0.0 { 1.0 } else { -1.0 };
         (rs.x0, rs.len) = (run.x0, run.x1 - run.x0);
     }
 
@@ -454,6 +454,7 @@ impl<'a> Shader<'a> {
     fn phong_run<'l>(
         &self,
         rs: &mut RunShading,
+        triangle_setup: &[DVec3; 6],
         lanes: &mut LineLanes,
         f64_only: bool,
         lit: impl Fn(usize) -> &'l [f32] + Copy,
@@ -464,7 +465,7 @@ impl<'a> Shader<'a> {
         }
         let geometry = if f64_only { None } else { self.lane_geometry(rs) };
         if let Some(mut g) = geometry.filter(|_| self.lights_fit_lanes(rs)) {
-            let normal = if triangle { self.triangle_normals(rs) } else { self.crossing_normals(rs) };
+            let normal = if triangle { self.triangle_normals(rs, triangle_setup) } else { self.crossing_normals(rs) };
             if let Some(normal) = normal {
                 g.normal = normal.map(|n| n.as_vec3().to_array());
                 g.plane = (self.scene.polygons[rs.poly].plane.n * rs.flip).as_vec3().to_array();
@@ -487,26 +488,29 @@ impl<'a> Shader<'a> {
     }
 
     /// A triangle's interpolated normal at pixel `x0 + i` of the run, unnormalised:
-    /// `N₀ + i N₁`. The barycentric weight of vertex `k` seen along a ray `d` from the eye
-    /// is `e_k·d / Σ e_j·d`, with `e_k` the cross product of the other two vertices (less
-    /// the eye), so the weighted sum of the vertex normals, times the denominator, is
-    /// linear in `d` and so in `i`; the denominator's sign is the same over the triangle.
-    /// Equal to the crossings' interpolation (linear along the edges, then along the scan
-    /// plane), which for a triangle is barycentric.
-    fn triangle_normals(&self, rs: &RunShading) -> Option<[DVec3; 2]> {
-        let (v, vn) = rs.triangle.split_at(3);
-        let eye = self.view.eye;
-        let [a, b, c] = [v[0] - eye, v[1] - eye, v[2] - eye];
-        let e = [b.cross(c), c.cross(a), a.cross(b)];
-        let sign = (e[0] + e[1] + e[2]).dot(rs.ray).signum() * rs.flip;
-        let along = |d: DVec3| (vn[0] * e[0].dot(d) + vn[1] * e[1].dot(d) + vn[2] * e[2].dot(d)) * sign;
+    /// `N₀ + i N₁`, from its [`Shader::triangle`] `[e₀, e₁, e₂, n₀, n₁, n₂]`. The
+    /// barycentric weight of vertex `k` seen along a ray `d` from the eye is
+    /// `e_k·d / Σ e_j·d`, so the weighted sum of the vertex normals, times the denominator,
+    /// is linear in `d` and so in `i`; the denominator's sign is the same over the
+    /// triangle. Equal to the crossings' interpolation (linear along the edges, then along
+    /// the scan plane), which for a triangle is barycentric.
+    fn triangle_normals(&self, rs: &RunShading, t: &[DVec3; 6]) -> Option<[DVec3; 2]> {
+        let [e0, e1, e2, n0, n1, n2] = *t;
+        let sign = (e0 + e1 + e2).dot(rs.ray).signum() * rs.flip;
+        let along = |d: DVec3| (n0 * e0.dot(d) + n1 * e1.dot(d) + n2 * e2.dot(d)) * sign;
         Some([along(rs.ray), along(self.view.ray_step())])
     }
 
-    /// Polygon `poly`'s corners and vertex normals when it is a triangle (zero otherwise).
+    /// For triangle `poly`, `[e₀, e₁, e₂, n₀, n₁, n₂]`: `e_k` the cross product of its other
+    /// two corners less the eye (`e₀ = b × c` and round), `n_k` its vertex normals; zero
+    /// for other polygons.
     fn triangle(&self, poly: usize) -> [DVec3; 6] {
         match (self.scene.verts(poly), self.scene.vertex_normals(poly)) {
-            (&[a, b, c], &[na, nb, nc]) => [a, b, c, na, nb, nc],
+            (&[a, b, c], &[na, nb, nc]) => {
+                let eye = self.view.eye;
+                let [a, b, c] = [a - eye, b - eye, c - eye];
+                [b.cross(c), c.cross(a), a.cross(b), na, nb, nc]
+            }
             _ => [DVec3::ZERO; 6],
         }
     }
@@ -552,7 +556,7 @@ impl<'a> Shader<'a> {
         let plane = &self.scene.polygons[rs.poly].plane;
         let step = self.view.ray_step();
         let ray = rs.ray_row + step * rs.x0 as f64;
-        let depth = -plane.distance(self.view.eye);
+        let depth = -rs.eye_distance;
         let den = [plane.n.dot(ray), plane.n.dot(step)];
         let reach2 = |i: f64| ((ray + step * i) * (depth / (den[0] + i * den[1]))).length_squared();
         rs.reach = reach2(0.0).max(reach2((rs.len - 1) as f64)).sqrt();
