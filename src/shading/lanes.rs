@@ -166,12 +166,17 @@ fn store_wide(v: &mut [f32], at: usize, x: f32x8) {
     v[at..at + W].copy_from_slice(&x.to_array());
 }
 
-/// Writes `x` to `v` in `from..to`, and as scratch up to seven values past it
-/// ([`store_wide`]).
+/// Writes colour `x` to the three channels `v` in `from..to`, and as scratch up to seven
+/// values past it ([`store_wide`]).
 #[inline(always)]
-fn fill_wide(v: &mut [f32], from: usize, to: usize, x: f32) {
+fn fill_wide(v: &mut [Vec<f32x8>; 3], from: usize, to: usize, x: Vec3) {
+    let [r, g, b] = v;
+    let (r, g, b) = (flat_mut(r), flat_mut(g), flat_mut(b));
+    let x = splat(x.to_array());
     for at in (from..to).step_by(W) {
-        store_wide(v, at, f32x8::splat(x));
+        store_wide(r, at, x[0]);
+        store_wide(g, at, x[1]);
+        store_wide(b, at, x[2]);
     }
 }
 
@@ -226,18 +231,13 @@ impl LineLanes {
     /// the pixels since the last run are background.
     pub fn start_run(&mut self, x0: usize, x1: usize, ambient: Vec3) {
         self.background_to(x0);
-        for (c, v) in self.acc.iter_mut().enumerate() {
-            fill_wide(flat_mut(v), x0, x1, ambient[c]);
-        }
+        fill_wide(&mut self.acc, x0, x1, ambient);
         self.claimed = x1;
     }
 
     /// Makes the pixels from the last run's end to `x` background.
     fn background_to(&mut self, x: usize) {
-        let from = self.claimed.min(x);
-        for (c, v) in self.acc.iter_mut().enumerate() {
-            fill_wide(flat_mut(v), from, x, self.background[c]);
-        }
+        fill_wide(&mut self.acc, self.claimed.min(x), x, self.background);
     }
 
     /// Flat: adds one colour to the run at `x0`, weighted by `lit` (one value per pixel).

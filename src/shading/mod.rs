@@ -193,12 +193,14 @@ struct RunShading {
     /// +1 or -1: turns the polygon's normals toward the viewer.
     flip: f64,
     /// The run's first pixel and its length, its line's centre, the normal of the line's
-    /// scan plane, and the ray through the line's first pixel centre.
+    /// scan plane, the ray through the line's first pixel centre, and its change from one
+    /// pixel to the next.
     x0: u32,
     len: u32,
     yc: f64,
     scan_normal: DVec3,
     ray_row: DVec3,
+    step: DVec3,
     /// The scan plane's crossings with the polygon's edges, sorted along `along`, the line
     /// where the polygon meets the scan plane.
     crossings: Vec<ScanCrossing>,
@@ -310,6 +312,7 @@ impl<'a> Shader<'a> {
         // The scan plane holds the eye and every ray of this scanline.
         rs.scan_normal = self.view.ray(0.0, rs.yc).cross(self.view.r);
         rs.ray_row = self.view.ray(0.5, rs.yc);
+        rs.step = self.view.ray_step();
         ls.triangles.clear();
         ls.triangles.extend(runs.iter().map(|run| self.triangle(run.poly as usize)));
         for (run, triangle) in runs.iter().zip(&ls.triangles) {
@@ -498,7 +501,7 @@ impl<'a> Shader<'a> {
         let [e0, e1, e2, n0, n1, n2] = *t;
         let sign = (e0 + e1 + e2).dot(rs.ray).signum() * rs.flip;
         let along = |d: DVec3| (n0 * e0.dot(d) + n1 * e1.dot(d) + n2 * e2.dot(d)) * sign;
-        Some([along(rs.ray), along(self.view.ray_step())])
+        Some([along(rs.ray), along(rs.step)])
     }
 
     /// For triangle `poly`, `[e₀, e₁, e₂, n₀, n₁, n₂]`: `e_k` the cross product of its other
@@ -554,7 +557,7 @@ impl<'a> Shader<'a> {
     /// single precision ([`LANE_REACH`]); keeps the f64 values in `rs` for what follows.
     fn lane_geometry(&self, rs: &mut RunShading) -> Option<RunGeometry> {
         let plane = &self.scene.polygons[rs.poly].plane;
-        let step = self.view.ray_step();
+        let step = rs.step;
         let ray = rs.ray_row + step * rs.x0 as f64;
         let depth = -rs.eye_distance;
         let den = [plane.n.dot(ray), plane.n.dot(step)];
@@ -590,7 +593,7 @@ impl<'a> Shader<'a> {
         if r.u <= l.u {
             return ([0.5, 0.0], [1.0, 0.0]);
         }
-        let (du, depth, den, step) = (r.u - l.u, rs.depth, rs.den, self.view.ray_step());
+        let (du, depth, den, step) = (r.u - l.u, rs.depth, rs.den, rs.step);
         let num = [depth * rs.ray.dot(rs.along) - l.u * den[0], depth * step.dot(rs.along) - l.u * den[1]];
         (num, [du * den[0], du * den[1]])
     }
