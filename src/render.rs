@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::frame::{Frame, PixelCounters};
 use crate::progress::{Progress, ProgressFn, Reporter};
 use crate::reflection::ReflectionMethod;
-use crate::scene::Scene;
+use crate::scene::{LightSample, Scene};
 use crate::shading::{LineShading, Shader};
 use crate::shadow::{ShadowContext, ShadowDatabase, ShadowMethod};
 use crate::stats::{Counters, Stats};
@@ -492,6 +492,9 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
     let mut lit = vec![0.0f32; ctx.lit_rows() * w as usize];
     let mut line_shading = LineShading::default();
     let (mut self_shadowed, mut walking, mut shading) = (0u64, Duration::ZERO, Duration::ZERO);
+    // Each sample's light, and the share of its light's lit fraction it holds.
+    let samples: Vec<(usize, usize, f32)> =
+        ctx.all_samples().map(|(l, s, _)| (l, s, 1.0 / ctx.samples[l].len() as f32)).collect();
     for (y, runs) in (y0..y1).zip(&ctx.runs.lines[y0 as usize..y1 as usize]) {
         let row = ((y - y0) * w) as usize;
         let t = Instant::now();
@@ -516,7 +519,7 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
             let (a, b) = (row + run.x0 as usize, row + run.x1 as usize);
             clear(gap..a, id, &mut light);
             id[a..b].fill(ctx.scene.polygons[run.poly as usize].face);
-            for (k, (l, s, _)) in ctx.all_samples().enumerate() {
+            for (k, &(l, s, share)) in samples.iter().enumerate() {
                 let lit = &lit[k * w as usize + run.x0 as usize..][..b - a];
                 if walker.whole_light(l) {
                     // The stage's answer for the whole light is its fraction.
@@ -525,7 +528,6 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
                     }
                     continue;
                 }
-                let share = 1.0 / ctx.samples[l].len() as f32;
                 // A light's first sample writes its lit fraction, the others add to it.
                 for (f, &v) in light[l][a..b].iter_mut().zip(lit) {
                     *f = if s == 0 { v * share } else { *f + v * share };
@@ -670,9 +672,10 @@ pub(crate) fn walk_line(
 ) -> u64 {
     let width = ctx.view.width as usize;
     let mut self_shadowed = 0;
+    let samples: smallvec::SmallVec<[(usize, usize, LightSample); 4]> = ctx.all_samples().collect();
     for run in runs {
         let plane = &ctx.scene.polygons[run.poly as usize].plane;
-        for (k, (l, s, sample)) in ctx.all_samples().enumerate() {
+        for (k, &(l, s, sample)) in samples.iter().enumerate() {
             let row = k * width + run.x0 as usize..k * width + run.x1 as usize;
             if walker.whole_light(l) {
                 // The stage answers for the whole light: sample 0's row holds the answer,
