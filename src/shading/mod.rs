@@ -457,7 +457,7 @@ impl<'a> Shader<'a> {
     fn phong_run<'l>(
         &self,
         rs: &mut RunShading,
-        triangle_setup: &[DVec3; 6],
+        barycentric: &[DVec3; 6],
         lanes: &mut LineLanes,
         f64_only: bool,
         lit: impl Fn(usize) -> &'l [f32] + Copy,
@@ -468,7 +468,7 @@ impl<'a> Shader<'a> {
         }
         let geometry = if f64_only { None } else { self.lane_geometry(rs) };
         if let Some(mut g) = geometry.filter(|_| self.lights_fit_lanes(rs)) {
-            let normal = if triangle { self.triangle_normals(rs, triangle_setup) } else { self.crossing_normals(rs) };
+            let normal = if triangle { self.triangle_normals(rs, barycentric) } else { self.crossing_normals(rs) };
             if let Some(normal) = normal {
                 g.normal = normal.map(|n| n.as_vec3().to_array());
                 g.plane = (self.scene.polygons[rs.poly].plane.n * rs.flip).as_vec3().to_array();
