@@ -308,6 +308,13 @@ impl View {
         self.clip_project_to(verts, self.far, scratch, out)
     }
 
+    /// A world point's place on screen as [`Self::clip_project_homogeneous`] gives a corner
+    /// of a polygon it finds whole: through the camera on its own, by the same steps, so with
+    /// the same bits (a shared edge's image is the same from every polygon on it).
+    pub(crate) fn image(&self, p: DVec3) -> DVec2 {
+        self.project(self.homogeneous_in_camera(p.extend(1.0)).truncate())
+    }
+
     /// Camera coordinates of a homogeneous world point (`w` kept).
     #[inline]
     pub(crate) fn homogeneous_in_camera(&self, h: DVec4) -> DVec4 {

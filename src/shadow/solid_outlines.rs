@@ -42,7 +42,7 @@ use super::projection::Target;
 use crate::pool::Stash;
 use crate::scene::{LightSample, Scene};
 use crate::view::View;
-use glam::{DVec2, DVec3, DVec4};
+use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::{Arc, OnceLock};
 
@@ -135,16 +135,11 @@ impl SolidOutlines {
     }
 }
 
-/// A point of the receiver's plane on screen, put through the camera on its own.
-pub(crate) fn image(view: &View, x: DVec3) -> DVec2 {
-    view.project(view.homogeneous_in_camera(DVec4::from((x, 1.0))).truncate())
-}
-
 /// Step 2's edges on screen: each of `edges` (a solid's boundary) projected onto `target`'s
 /// plane and by the camera, run `winding` times, onto `out`.
 pub(crate) fn push_outline(view: &View, target: &Target, edges: &[[DVec3; 2]], winding: i32, out: &mut Vec<FarEdge>) {
     out.extend(
-        edges.iter().map(|&[p, q]| FarEdge::run(image(view, target.onto(p)), image(view, target.onto(q)), winding)),
+        edges.iter().map(|&[p, q]| FarEdge::run(view.image(target.onto(p)), view.image(target.onto(q)), winding)),
     );
 }
 

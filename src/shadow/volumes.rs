@@ -220,6 +220,7 @@ fn shadow_polygons(
     // closed mesh run its image once each way and leave nothing; an edge they run more one
     // way than the other is kept, run that many times (the far end of a side).
     if let (Some(far), true) = (&b.far, far_outline) {
+        let view = ctx.view;
         let edges = adjacency.edge_pieces().map(|edges| {
             let mut piece = Piece::default();
             for (e, sharing) in edges {
@@ -235,10 +236,10 @@ fn shadow_polygons(
                 }
                 let (ea, eb) = e.ends(ctx.scene);
                 if far_runs != 0 {
-                    piece.far.push(FarEdge::run(b.far_image(far, ea), b.far_image(far, eb), far_runs));
+                    piece.far.push(FarEdge::run(view.image(far.onto(ea)), view.image(far.onto(eb)), far_runs));
                 }
                 if front_runs != 0 {
-                    piece.far.push(FarEdge::run(b.front_image(ea), b.front_image(eb), front_runs));
+                    piece.far.push(FarEdge::run(view.image(ea), view.image(eb), front_runs));
                 }
             }
             piece
@@ -512,21 +513,6 @@ impl<'c> Builder<'c> {
         let far = far.map(|f| Target::new(f.plane, f.rect, sample));
         let far_facing = far.as_ref().map_or(0, |f| far_outline::facing(ctx.view, &f.plane));
         Builder { ctx, sample, counting, near: Target::new(plane, rect, sample), far, far_facing }
-    }
-
-    /// Corner `v`'s image on screen as a far cap whole on screen has it: projected from the
-    /// light onto the far plane `far`, then put through the camera (the same steps, so the
-    /// same bits).
-    fn far_image(&self, far: &Target, v: DVec3) -> DVec2 {
-        let view = self.ctx.view;
-        view.project(view.homogeneous_in_camera(finite(far.onto(v))).truncate())
-    }
-
-    /// Corner `v`'s image on screen as a front cap whole on screen has it: put through the
-    /// camera alone (the same steps, so the same bits).
-    fn front_image(&self, v: DVec3) -> DVec2 {
-        let view = self.ctx.view;
-        view.project(view.homogeneous_in_camera(finite(v)).truncate())
     }
 
     /// The normal of the plane through edge `a → b` and the light (not normalised; zero when
