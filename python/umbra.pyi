@@ -53,9 +53,9 @@ def render(
 ) -> Frame:
     """Renders the scene with a visibility and a shadow stage (paper=True: as published).
     Keyword settings set the stage's options by their names in the engine: prefilter,
-    sphere_grid, seen_receivers, drop_behind, wedge, solid_outlines, solid_cull, convex_split,
-    backgrounds, lone_sheets, tiling, face_binning, sort_grid, counting ("zpass", "zfail",
-    "naive-zpass"),
+    sphere_grid, seen_receivers, drop_behind, wedge, solid_outlines, own_solid, solid_cull,
+    convex_split, backgrounds, lone_sheets, tiling, face_binning, sort_grid, counting
+    ("zpass", "zfail", "naive-zpass"),
     construction ("merged", "per-polygon", "crow-1977"), sight_cuts, far_outline, front_outline, map_size,
     bias, slope_bias, normal_offset, receiver_plane, cull_front, fit_to_view, hull_cull,
     convex_bodies, same_solid, premise_fallback, lambert."""

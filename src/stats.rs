@@ -113,6 +113,9 @@ counters! {
     StageBytes = "stage_bytes",
     /// Z-buffer: the bytes of its depth and id buffers.
     BufferBytes = "buffer_bytes",
+    /// Bouknight-Kelley: the bytes of the front sets and solids' trees kept for the scene's
+    /// polygons (`own_solid`).
+    OwnSolidBytes = "own_solid_bytes",
     /// Ray-cast visibility: the rays cast, one per pixel.
     Rays = "rays",
     /// Bouknight-Kelley: ordered pairs of polygons, n(n − 1), per light sample; Nishita-Nakamae:
@@ -132,6 +135,11 @@ counters! {
     PairsKeptByPrefilter = "pairs_kept_by_prefilter",
     /// Bouknight-Kelley: the pairs the prefilter tested (without its sphere grid).
     PairsTestedByPrefilter = "pairs_tested_by_prefilter",
+    /// Bouknight-Kelley: receivers that took only their front set of their own closed
+    /// solid's casters (`own_solid`).
+    ReceiversOnOwnSolid = "receivers_on_own_solid",
+    /// Bouknight-Kelley: the polygons of those front sets, summed over the receivers.
+    OwnSolidFront = "own_solid_front",
     /// Bouknight-Kelley: kept pairs whose caster lies wholly behind the receiver from the light.
     PairsDroppedBehind = "pairs_dropped_behind",
     /// Bouknight-Kelley: kept pairs whose caster's shadow misses the receiver (the wedge test).

@@ -143,13 +143,14 @@ fn named<T: std::str::FromStr<Err = um::Error>>(v: &Bound<'_, PyAny>) -> PyResul
 }
 
 /// Every keyword setting [`stage_settings`] knows, by name.
-const SETTINGS: [(&str, Setter); 30] = [
+const SETTINGS: [(&str, Setter); 31] = [
     ("prefilter", |s, v| v.extract().map(|x| s.bouknight_kelley.prefilter = x)),
     ("sphere_grid", |s, v| v.extract().map(|x| s.bouknight_kelley.sphere_grid = x)),
     ("seen_receivers", |s, v| v.extract().map(|x| s.bouknight_kelley.seen_receivers = x)),
     ("drop_behind", |s, v| v.extract().map(|x| s.bouknight_kelley.drop_behind = x)),
     ("wedge", |s, v| v.extract().map(|x| s.bouknight_kelley.wedge = x)),
     ("solid_outlines", |s, v| v.extract().map(|x| s.bouknight_kelley.solid_outlines = x)),
+    ("own_solid", |s, v| v.extract().map(|x| s.bouknight_kelley.own_solid = x)),
     ("solid_cull", |s, v| {
         let on = v.extract()?;
         s.bouknight_kelley.solid_cull = on;

@@ -37,6 +37,7 @@
 
 use super::far_outline::{self, FarEdge};
 use super::overlay::{Interval, Overlay, OverlayWalker, ReceiverTable};
+use super::own_solid::{Own, OwnSolid};
 use super::projection::{bounding_rectangle, edge_on, faces_away_on_solid, light_side, Projector, Target};
 use super::solid_outlines::{self, SolidOutlines};
 use super::{
@@ -127,6 +128,7 @@ fn shadow_polygons(
     // receiver would outline every solid whose shadow misses it.
     let outlines = (options.solid_outlines && options.prefilter && !ctx.keep_outlines)
         .then(|| SolidOutlines::new(scene, &casters, sample, &ctx.pools.stash));
+    let own = (options.own_solid && options.drop_behind).then(|| OwnSolid::kept(scene, &ctx.pools.stash));
     let t = Instant::now();
     let extents = options.prefilter.then(|| Extents::new(scene, sample, &casters, &receivers));
     let (grid, extents) = match extents {
@@ -155,10 +157,14 @@ fn shadow_polygons(
             |(work, stamp, candidates), &b| {
                 let t = Instant::now();
                 let mut tested = 0;
+                let own = own.as_deref().and_then(|o| o.of(scene, b, sample));
                 match (&grid, &extents) {
-                    (Some(g), _) => g.candidates(b, stamp, candidates),
+                    (Some(g), _) => g.candidates(b, own, &scene.solid_of, stamp, candidates),
                     (None, Some(e)) => tested = e.every_pair(b, &casters, candidates),
                     (None, None) => candidates.clone_from(&casters),
+                }
+                if let (Some(o), None) = (own, &grid) {
+                    candidates.retain(|&a| !o.skips(a, scene.solid_of[a as usize]));
                 }
                 let prefilter_ns = t.elapsed().as_nanos() as u64;
                 let t = Instant::now();
@@ -169,6 +175,8 @@ fn shadow_polygons(
                     _ => project_onto(onto, candidates, work),
                 };
                 tally.tested += tested;
+                tally.on_own_solid += own.is_some() as u64;
+                tally.own_solid_front += own.map_or(0, |o| o.front.len() as u64);
                 tally.prefilter_ns += prefilter_ns;
                 tally.projection_ns += t.elapsed().as_nanos() as u64;
                 (tally, table, pairs)
@@ -188,6 +196,11 @@ fn shadow_polygons(
         if !options.sphere_grid {
             counters.add(crate::stats::Counter::PairsTestedByPrefilter, total.tested);
         }
+    }
+    if let Some(own) = &own {
+        counters.add(crate::stats::Counter::ReceiversOnOwnSolid, total.on_own_solid);
+        counters.add(crate::stats::Counter::OwnSolidFront, total.own_solid_front);
+        counters.add(crate::stats::Counter::OwnSolidBytes, own.bytes() as u64);
     }
     if options.drop_behind {
         counters.add(crate::stats::Counter::PairsDroppedBehind, total.behind);
@@ -476,6 +489,8 @@ fn merge(ctx: &ShadowContext, pieces: Vec<Piece>) -> (Overlay, Tally, FxHashMap<
 #[derive(Default, Clone)]
 struct Tally {
     tested: u64,
+    on_own_solid: u64,
+    own_solid_front: u64,
     outlines: u64,
     outlined: u64,
     kept: u64,
@@ -489,6 +504,8 @@ struct Tally {
 impl Tally {
     fn add(&mut self, o: &Tally) {
         self.tested += o.tested;
+        self.on_own_solid += o.on_own_solid;
+        self.own_solid_front += o.own_solid_front;
         self.outlines += o.outlines;
         self.outlined += o.outlined;
         self.kept += o.kept;
@@ -722,22 +739,45 @@ impl SphereGrid {
 
     /// The casters whose extents overlap receiver `b`'s: those sharing a grid cell with it
     /// whose bounding cones overlap (for a point light; shared cells suffice for a
-    /// directional light, whose boxes are the cells' own test). `stamp` is scratch, one entry
-    /// per polygon, that keeps each caster from being listed twice.
-    fn candidates(&self, b: u32, stamp: &mut [u32], out: &mut Vec<u32>) {
+    /// directional light, whose boxes are the cells' own test), less those of `b`'s own
+    /// solid that `own` passes over (by `solid_of`; in a cell, as one stretch where the
+    /// solid's polygons are one range). `stamp` is scratch, one entry per polygon, that keeps
+    /// each caster from being listed twice.
+    fn candidates(&self, b: u32, own: Option<Own>, solid_of: &[u32], stamp: &mut [u32], out: &mut Vec<u32>) {
         out.clear();
         for (c, r) in self.cells_of(b) {
-            for &a in self.cell(c, r) {
-                if stamp[a as usize] == b {
-                    continue;
+            let cell = self.cell(c, r);
+            match own.and_then(|o| Some((o, o.stretch(cell)?))) {
+                Some((o, (start, end))) => {
+                    let stretch = &cell[start..end];
+                    let front = o.front.iter().filter(|f| stretch.binary_search(f).is_ok());
+                    for &a in cell[..start].iter().chain(front).chain(&cell[end..]) {
+                        self.offer(a, b, stamp, out);
+                    }
                 }
-                stamp[a as usize] = b;
-                // Shared cells are a directional light's box test; a point light's cones
-                // are compared.
-                if !self.extents.point() || self.extents.overlap(a, b) {
-                    out.push(a);
+                None => {
+                    for &a in cell {
+                        if !own.is_some_and(|o| o.skips(a, solid_of[a as usize])) {
+                            self.offer(a, b, stamp, out);
+                        }
+                    }
                 }
             }
+        }
+    }
+
+    /// Lists caster `a` for receiver `b` unless it is listed already or its cone misses
+    /// `b`'s.
+    #[inline(always)]
+    fn offer(&self, a: u32, b: u32, stamp: &mut [u32], out: &mut Vec<u32>) {
+        if stamp[a as usize] == b {
+            return;
+        }
+        stamp[a as usize] = b;
+        // Shared cells are a directional light's box test; a point light's cones are
+        // compared.
+        if !self.extents.point() || self.extents.overlap(a, b) {
+            out.push(a);
         }
     }
 }
@@ -975,7 +1015,7 @@ mod tests {
             let mut stamp = vec![u32::MAX; n];
             let (mut found, mut kept) = (0, Vec::new());
             for b in 0..n as u32 {
-                grid.candidates(b, &mut stamp, &mut kept);
+                grid.candidates(b, None, &scene.solid_of, &mut stamp, &mut kept);
                 let t = scene.verts(b as usize);
                 for _ in 0..200 {
                     let (u, v) = (rng.gen_range(0.0..1.0f64), rng.gen_range(0.0..1.0f64));

@@ -13,6 +13,7 @@ mod crow;
 mod far_outline;
 mod nishita_nakamae;
 mod overlay;
+mod own_solid;
 mod planar;
 mod projection;
 mod ray_cast;
@@ -91,6 +92,11 @@ pub struct BouknightKelleyOptions {
     /// the light. `false` projects each, as the paper does. Traces keep each polygon; it
     /// works with the prefilter, whose candidates it counts.
     pub solid_outlines: bool,
+    /// Take, of the casters on a receiver's own closed solid, only its front set: those with
+    /// a corner in front of the receiver's plane, found once for the polygons (default true;
+    /// ours, with `drop_behind`, which drops every other). `false` gathers each from the
+    /// prefilter and finds it behind the receiver, one pair at a time.
+    pub own_solid: bool,
 }
 
 impl BouknightKelleyOptions {
@@ -103,6 +109,7 @@ impl BouknightKelleyOptions {
         wedge: true,
         solid_cull: true,
         solid_outlines: true,
+        own_solid: true,
     };
 
     /// The paper's method as published: every ordered pair through the sphere prefilter,
@@ -115,6 +122,7 @@ impl BouknightKelleyOptions {
         wedge: false,
         solid_cull: false,
         solid_outlines: false,
+        own_solid: false,
     };
 }
 
@@ -927,6 +935,7 @@ impl ShadowMethod {
                     on.push((!o.wedge, "--no-wedge".into()));
                     on.push((!o.solid_cull, "--no-solid-cull".into()));
                     on.push((!o.solid_outlines, "--no-solid-outlines".into()));
+                    on.push((!o.own_solid, "--no-own-solid".into()));
                 }
             }
             ShadowMethod::AthertonWeilerGreenberg(_) if paper => {}

@@ -232,6 +232,11 @@ struct ShadowArgs {
     /// their union (ours).
     #[arg(long)]
     no_solid_outlines: bool,
+    /// Bouknight-Kelley: gather each caster on a receiver's own closed solid and find it
+    /// behind the receiver, instead of taking only the solid's front set of that receiver
+    /// (ours).
+    #[arg(long)]
+    no_own_solid: bool,
     /// Bouknight-Kelley, Atherton-Weiler-Greenberg and Nishita-Nakamae: keep the polygons of
     /// closed solids that face away from the light (as casters; in AWG's light views), as the
     /// papers do (to measure what dropping them saves).
@@ -387,6 +392,7 @@ impl ShadowArgs {
                 wedge: !self.no_wedge,
                 solid_cull: !self.no_solid_cull,
                 solid_outlines: !self.no_solid_outlines,
+                own_solid: !self.no_own_solid,
             },
             atherton_weiler_greenberg: self.awg.options(!self.no_solid_cull),
             volumes: VolumeOptions {
