@@ -96,7 +96,8 @@ impl OwnSolid {
     /// No tree and no front set yet: each is made the first time it is asked for.
     fn new(scene: &Scene) -> Self {
         let trees = (0..scene.solids.len()).map(|_| OnceLock::new()).collect();
-        let front = (0..scene.polygons.len()).map(|_| OnceLock::new()).collect();
+        let polygons = if scene.solids.is_empty() { 0 } else { scene.polygons.len() };
+        let front = (0..polygons).map(|_| OnceLock::new()).collect();
         OwnSolid { members: scene.solid_members(), trees, front }
     }
 

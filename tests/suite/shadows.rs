@@ -894,11 +894,14 @@ fn merged_volumes_leave_out_closed_solids_turned_away() {
 
 /// Bouknight-Kelley drops a caster that shares corners with its receiver and otherwise lies
 /// behind it, even when rounding puts a shared corner a hair in front of the receiver's
-/// plane: on a sphere lit from outside, the prefilter keeps each polygon's neighbours, and
-/// none of them is projected.
+/// plane: on a sphere lit from outside, the prefilter keeps each polygon's neighbours (with
+/// the own solid's front sets off: they would leave it only the neighbours with a corner in
+/// front), and none of them is projected. With the front sets on, those few are dropped as
+/// behind too.
 #[test]
 fn neighbours_behind_their_receiver_are_never_projected() {
     use umbra::scene::{Camera, Light, Material, Object};
+    use umbra::shadow::BouknightKelleyOptions;
     let centre = glam::DVec3::new(0.1, 0.7, -0.3);
     for levels in [1, 2, 3] {
         let camera = Camera { width: 64, height: 48, ..Camera::new(glam::DVec3::new(0.3, 1.9, 4.1), centre) };
@@ -908,17 +911,21 @@ fn neighbours_behind_their_receiver_are_never_projected() {
             .object(Object::new(umbra::generate::geodesic_sphere(centre, 0.77, levels)), "m")
             .build()
             .unwrap();
-        let opts =
-            umbra::RenderOptions { shadows: ShadowMethod::BouknightKelley(Default::default()), ..Default::default() };
-        let c = umbra::render(&scene, &opts).unwrap().stats.shadow_counters;
-        let kept = c.get(umbra::Counter::PairsKeptByPrefilter);
-        assert!(kept > 0, "level {levels}: the prefilter kept no neighbours");
-        assert_eq!(
-            c.get(umbra::Counter::PairsDroppedBehind),
-            kept,
-            "level {levels}: a neighbour was not dropped as behind"
-        );
-        assert_eq!(c.get(umbra::Counter::ShadowPolygons), 0, "level {levels}");
+        for own_solid in [false, true] {
+            let bk = BouknightKelleyOptions { own_solid, ..Default::default() };
+            let opts = umbra::RenderOptions { shadows: ShadowMethod::BouknightKelley(bk), ..Default::default() };
+            let c = umbra::render(&scene, &opts).unwrap().stats.shadow_counters;
+            let kept = c.get(umbra::Counter::PairsKeptByPrefilter);
+            let label = format!("level {levels}, own solid {own_solid}");
+            assert!(own_solid || kept > 0, "{label}: the prefilter kept no neighbours");
+            assert!(!own_solid || c.get(umbra::Counter::ReceiversOnOwnSolid) > 0, "{label}: no front set taken");
+            assert_eq!(
+                c.get(umbra::Counter::PairsDroppedBehind),
+                kept,
+                "{label}: a neighbour was not dropped as behind"
+            );
+            assert_eq!(c.get(umbra::Counter::ShadowPolygons), 0, "{label}");
+        }
     }
 }
 
