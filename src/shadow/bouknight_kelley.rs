@@ -440,6 +440,9 @@ fn project_each(
 /// Casters whose grid keys one piece of the grid's parallel loop writes.
 const KEY_CHUNK: usize = 4096;
 
+/// Grid cells whose first keys one piece of the grid's parallel loop finds.
+const CELL_CHUNK: usize = 4096;
+
 /// The most receivers one piece of the parallel loop over them takes.
 const RECEIVERS_PER_PIECE: usize = 512;
 
@@ -731,8 +734,8 @@ impl SphereGrid {
         // Where each cell's keys start: each stretch of cells finds its first by bisection and
         // walks the keys from there (a bisection for every cell was a sixth of the grid).
         grid.first = vec![0; g * g + 1];
-        grid.first.par_chunks_mut(KEY_CHUNK).enumerate().for_each(|(j, first)| {
-            let k0 = j * KEY_CHUNK;
+        grid.first.par_chunks_mut(CELL_CHUNK).enumerate().for_each(|(j, first)| {
+            let k0 = j * CELL_CHUNK;
             let mut at = keys.partition_point(|&key| key >> 32 < k0 as u64);
             for (k, start) in (k0..).zip(first.iter_mut()) {
                 while keys.get(at).is_some_and(|&key| key >> 32 < k as u64) {
