@@ -74,6 +74,10 @@ def test_stage_settings_are_keywords(scene):
     assert "shadow.pairs_kept_by_prefilter" in default.counters
     assert "shadow.pairs_kept_by_prefilter" not in unfiltered.counters
     assert (default.light[0] == unfiltered.light[0]).all(), "a step of ours changes no pixel"
+    gathered = umbra.render(scene, shadows="bouknight-kelley", own_solid=False)
+    assert "shadow.receivers_on_own_solid" in default.counters
+    assert "shadow.receivers_on_own_solid" not in gathered.counters
+    assert (default.light[0] == gathered.light[0]).all(), "the front sets change no pixel"
     zfail = umbra.render(scene, shadows="crow", counting="zfail")
     assert (zfail.light[0] == default.light[0]).mean() > 0.99
     caps = umbra.render(scene, shadows="crow", counting="zfail", far_outline=False)
