@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::frame::{Frame, PixelCounters};
 use crate::progress::{Progress, ProgressFn, Reporter};
 use crate::reflection::ReflectionMethod;
-use crate::scene::{LightSample, Scene};
+use crate::scene::Scene;
 use crate::shading::{LineShading, Shader};
 use crate::shadow::{ShadowContext, ShadowDatabase, ShadowMethod};
 use crate::stats::{Counters, Stats};
@@ -672,10 +672,9 @@ pub(crate) fn walk_line(
 ) -> u64 {
     let width = ctx.view.width as usize;
     let mut self_shadowed = 0;
-    let samples: smallvec::SmallVec<[(usize, usize, LightSample); 4]> = ctx.all_samples().collect();
     for run in runs {
         let plane = &ctx.scene.polygons[run.poly as usize].plane;
-        for (k, &(l, s, sample)) in samples.iter().enumerate() {
+        for (k, (l, s, sample)) in ctx.all_samples().enumerate() {
             let row = k * width + run.x0 as usize..k * width + run.x1 as usize;
             if walker.whole_light(l) {
                 // The stage answers for the whole light: sample 0's row holds the answer,

@@ -384,6 +384,9 @@ pub(crate) struct ShadowContext<'a> {
     pub(crate) awg_database: Option<std::sync::Arc<Vec<ShadowDatabase>>>,
     /// Each light's samples (`samples[light][sample]`).
     pub samples: Vec<Vec<LightSample>>,
+    /// Every `(light, sample, sample's position)`, in order ([`ShadowContext::all_samples`]),
+    /// listed once for the frame: a line's walk reads it for every run.
+    flat: Vec<(usize, usize, LightSample)>,
     /// The scene's size (diagonal of its bounds), for tolerances.
     pub extent: f64,
     /// Where frame-sized buffers (shadow maps) come from and go back to.
@@ -393,11 +396,13 @@ pub(crate) struct ShadowContext<'a> {
 impl<'a> ShadowContext<'a> {
     /// The context for rendering `scene` from `view`, whose visible runs are `runs`.
     pub fn new(scene: &'a Scene, view: &'a View, runs: &'a FrameRuns, keep_outlines: bool) -> Self {
-        let samples = scene.lights.iter().map(|l| l.samples()).collect();
+        let samples: Vec<Vec<LightSample>> = scene.lights.iter().map(|l| l.samples()).collect();
+        let flat = samples.iter().enumerate().flat_map(|(l, ss)| ss.iter().enumerate().map(move |(s, &x)| (l, s, x)));
+        let flat = flat.collect();
         let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
         let visible = runs.visible(scene.polygons.len());
         let pools = Default::default();
-        ShadowContext { scene, view, runs, visible, keep_outlines, awg_database: None, samples, extent, pools }
+        ShadowContext { scene, view, runs, visible, keep_outlines, awg_database: None, samples, flat, extent, pools }
     }
 
     /// The same context, with Atherton-Weiler-Greenberg's databases built beforehand.
@@ -413,7 +418,7 @@ impl<'a> ShadowContext<'a> {
     /// Every (light, sample) pair, in order: the flat index of sample `s` of light `l` is
     /// `sample_index(l, s)`.
     pub fn all_samples(&self) -> impl Iterator<Item = (usize, usize, LightSample)> + '_ {
-        self.samples.iter().enumerate().flat_map(|(l, ss)| ss.iter().enumerate().map(move |(s, &x)| (l, s, x)))
+        self.flat.iter().copied()
     }
 
     /// How many rows of lit values a line's walk fills (`render::walk_line`): one per light
