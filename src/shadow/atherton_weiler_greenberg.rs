@@ -39,7 +39,6 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::path::Path;
-use std::sync::Arc;
 use std::time::Instant;
 
 /// A lit fragment of a scene polygon: where one light sample reaches it.
@@ -56,6 +55,69 @@ pub struct DetailPolygon {
 pub struct ShadowDatabase {
     /// Per sample, the lit fragments.
     pub samples: Vec<Vec<DetailPolygon>>,
+}
+
+/// A lit fragment as pass 1 makes it (ours): a source polygon lit whole is its index alone,
+/// with no copy of its outline. On s3 nine in ten fragments are whole (the lone sheets'
+/// polygons); the public [`ShadowDatabase`] spells them out as [`DetailPolygon`]s.
+enum Lit {
+    Whole(u32),
+    Part(DetailPolygon),
+}
+
+impl Lit {
+    /// The fragment as the database keeps it.
+    fn into_detail(self, scene: &Scene) -> DetailPolygon {
+        match self {
+            Lit::Whole(source) => DetailPolygon { source, rings: vec![scene.verts(source as usize).to_vec()] },
+            Lit::Part(d) => d,
+        }
+    }
+}
+
+/// A lit fragment as the view pass reads it: a [`Lit`] of this frame's pass 1, or a
+/// [`DetailPolygon`] of a database given to the renderer.
+trait Fragment: Sync {
+    fn source(&self) -> u32;
+    /// Whether the fragment is its whole source polygon.
+    fn whole(&self, scene: &Scene) -> bool;
+    /// Its outlines in world space.
+    fn rings<'a>(&'a self, scene: &'a Scene) -> impl Iterator<Item = &'a [DVec3]>;
+}
+
+impl Fragment for Lit {
+    fn source(&self) -> u32 {
+        match self {
+            Lit::Whole(source) => *source,
+            Lit::Part(d) => d.source,
+        }
+    }
+
+    fn whole(&self, _: &Scene) -> bool {
+        matches!(self, Lit::Whole(_))
+    }
+
+    fn rings<'a>(&'a self, scene: &'a Scene) -> impl Iterator<Item = &'a [DVec3]> {
+        let (whole, part) = match self {
+            Lit::Whole(source) => (Some(scene.verts(*source as usize)), &[][..]),
+            Lit::Part(d) => (None, &d.rings[..]),
+        };
+        whole.into_iter().chain(part.iter().map(Vec::as_slice))
+    }
+}
+
+impl Fragment for DetailPolygon {
+    fn source(&self) -> u32 {
+        self.source
+    }
+
+    fn whole(&self, scene: &Scene) -> bool {
+        matches!(&self.rings[..], [r] if r[..] == *scene.verts(self.source as usize))
+    }
+
+    fn rings<'a>(&'a self, _: &'a Scene) -> impl Iterator<Item = &'a [DVec3]> {
+        self.rings.iter().map(Vec::as_slice)
+    }
 }
 
 /// A polygon (or a piece of one) in a light view: its region in the view's 2D coordinates
@@ -794,7 +856,7 @@ fn lit_in_view(
     view: LightView,
     extent: f64,
     stats: &mut Pass1,
-) -> std::result::Result<Vec<DetailPolygon>, ClipError> {
+) -> std::result::Result<Vec<Lit>, ClipError> {
     let mapped = Mapped::new(scene, unseen, view, extent);
     // Lone polygons and wide backgrounds leave the view before it is cut (ours).
     let lone = if stats.lone_sheets { take_lone(scene, &mapped, stats.backgrounds) } else { LoneSplit::default() };
@@ -815,14 +877,14 @@ fn lit_in_view(
     // polygon as it is).
     let unmap = |p: Piece| {
         if p.whole {
-            return DetailPolygon { source: p.source, rings: vec![scene.verts(p.source as usize).to_vec()] };
+            return Lit::Whole(p.source);
         }
         let plane = scene.polygons[p.source as usize].plane;
         let rings = p.region.rings.iter().map(|r| r.iter().map(|&q| view.unmap(q, &plane)).collect()).collect();
-        DetailPolygon { source: p.source, rings }
+        Lit::Part(DetailPolygon { source: p.source, rings })
     };
     let keep_cover = !lone.behind.is_empty();
-    let done: Vec<(Vec<DetailPolygon>, Vec<Piece>, Pass1)> = lists
+    let done: Vec<(Vec<Lit>, Vec<Piece>, Pass1)> = lists
         .into_par_iter()
         .with_max_len(1)
         .map(|(casters, others)| {
@@ -849,8 +911,7 @@ fn lit_in_view(
     let over: Vec<&Piece> = cover.iter().chain(&lone.outlines).collect();
     let behind: Vec<Piece> = lone.behind.into_par_iter().filter_map(|b| holed(b, over.iter().copied())).collect();
     detail.par_extend(behind.into_par_iter().map(unmap));
-    let whole = |source: u32| DetailPolygon { source, rings: vec![scene.verts(source as usize).to_vec()] };
-    detail.par_extend(lone.lone.into_par_iter().map(whole));
+    detail.par_extend(lone.lone.into_par_iter().map(Lit::Whole));
     Ok(detail)
 }
 
@@ -1203,6 +1264,63 @@ fn behind_all(b: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Resul
     Ok(holed(b, holes.into_iter()).into_iter().collect())
 }
 
+/// Pass 1 and the merge for light `light` of `scene` ([`ShadowDatabase::build`]): every
+/// sample's lit fragments. A point sample's six cube faces are independent, and are sorted in
+/// parallel.
+fn lit_fragments(
+    scene: &Scene,
+    light: usize,
+    options: AthertonWeilerGreenbergOptions,
+    counters: &mut Counters,
+) -> Result<Vec<Vec<Lit>>> {
+    let l = scene.lights.get(light).ok_or_else(|| {
+        Error::out_of_range(
+            "light",
+            light,
+            format!("a light of the scene (it has {}, numbered from 0)", scene.lights.len()),
+        )
+    })?;
+    let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
+    let t = Instant::now();
+    let mut done: Vec<(usize, Vec<Lit>, Pass1)> = Vec::new();
+    for (s, sample) in l.samples().into_iter().enumerate() {
+        let unseen = unseen(scene, sample, extent, options.solid_cull);
+        let face = cube_faces(scene, sample, &unseen);
+        let views: Vec<(Vec<Lit>, Pass1)> = LightView::views(sample)
+            .into_par_iter()
+            .enumerate()
+            .map(|(f, view)| {
+                let mut stats = Pass1::new(options);
+                // A polygon wholly inside one cube face is mapped into that face alone.
+                let elsewhere = |i: usize| matches!(face.get(i), Some(&Some(g)) if g != f as u8);
+                let unseen = |i: usize| unseen[i] || (options.face_binning && elsewhere(i));
+                let lit = lit_in_view(scene, unseen, view, extent, &mut stats).map_err(clip_error)?;
+                Ok((lit, stats))
+            })
+            .collect::<Result<_>>()?;
+        done.extend(views.into_iter().map(|(lit, stats)| (s, lit, stats)));
+    }
+    let mut samples: Vec<Vec<Lit>> = (0..l.sample_count()).map(|_| Vec::new()).collect();
+    let mut stats = Pass1::new(options);
+    for (s, lit, st) in done {
+        samples[s].extend(lit);
+        stats.add(&st);
+    }
+    counters.add(crate::stats::Counter::LightSpaceFragments, stats.fragments);
+    counters.add(crate::stats::Counter::ClipOperations, stats.clips);
+    counters.add(crate::stats::Counter::InterpenetrationSplits, stats.splits);
+    counters.add(crate::stats::Counter::AreaSortDepthMax, stats.depth_max);
+    counters.add(crate::stats::Counter::LightViewTiles, stats.tiles);
+    counters.add(crate::stats::Counter::LightViewBackgrounds, stats.backgrounds_found);
+    counters.add(crate::stats::Counter::LightViewLone, stats.lone);
+    let detail: usize = samples.iter().map(Vec::len).sum();
+    let verts: usize = samples.iter().flatten().flat_map(|d| d.rings(scene)).map(<[DVec3]>::len).sum();
+    counters.add(crate::stats::Counter::DetailPolygons, detail as u64);
+    counters.add(crate::stats::Counter::DetailVertices, verts as u64);
+    counters.add(crate::stats::Counter::Pass1Us, t.elapsed().as_micros() as u64);
+    Ok(samples)
+}
+
 impl ShadowDatabase {
     /// Pass 1 and the merge for light `light` of `scene`: every sample's lit detail polygons.
     /// A point sample's six cube faces are independent, and are sorted in parallel.
@@ -1212,52 +1330,9 @@ impl ShadowDatabase {
         options: AthertonWeilerGreenbergOptions,
         counters: &mut Counters,
     ) -> Result<ShadowDatabase> {
-        let l = scene.lights.get(light).ok_or_else(|| {
-            Error::out_of_range(
-                "light",
-                light,
-                format!("a light of the scene (it has {}, numbered from 0)", scene.lights.len()),
-            )
-        })?;
-        let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
-        let t = Instant::now();
-        let mut done: Vec<(usize, Vec<DetailPolygon>, Pass1)> = Vec::new();
-        for (s, sample) in l.samples().into_iter().enumerate() {
-            let unseen = unseen(scene, sample, extent, options.solid_cull);
-            let face = cube_faces(scene, sample, &unseen);
-            let views: Vec<(Vec<DetailPolygon>, Pass1)> = LightView::views(sample)
-                .into_par_iter()
-                .enumerate()
-                .map(|(f, view)| {
-                    let mut stats = Pass1::new(options);
-                    // A polygon wholly inside one cube face is mapped into that face alone.
-                    let elsewhere = |i: usize| matches!(face.get(i), Some(&Some(g)) if g != f as u8);
-                    let unseen = |i: usize| unseen[i] || (options.face_binning && elsewhere(i));
-                    let lit = lit_in_view(scene, unseen, view, extent, &mut stats).map_err(clip_error)?;
-                    Ok((lit, stats))
-                })
-                .collect::<Result<_>>()?;
-            done.extend(views.into_iter().map(|(lit, stats)| (s, lit, stats)));
-        }
-        let mut samples = vec![Vec::new(); l.sample_count()];
-        let mut stats = Pass1::new(options);
-        for (s, lit, st) in done {
-            samples[s].extend(lit);
-            stats.add(&st);
-        }
-        counters.add(crate::stats::Counter::LightSpaceFragments, stats.fragments);
-        counters.add(crate::stats::Counter::ClipOperations, stats.clips);
-        counters.add(crate::stats::Counter::InterpenetrationSplits, stats.splits);
-        counters.add(crate::stats::Counter::AreaSortDepthMax, stats.depth_max);
-        counters.add(crate::stats::Counter::LightViewTiles, stats.tiles);
-        counters.add(crate::stats::Counter::LightViewBackgrounds, stats.backgrounds_found);
-        counters.add(crate::stats::Counter::LightViewLone, stats.lone);
-        let detail: usize = samples.iter().map(Vec::len).sum();
-        let verts: usize = samples.iter().flatten().flat_map(|d| &d.rings).map(Vec::len).sum();
-        counters.add(crate::stats::Counter::DetailPolygons, detail as u64);
-        counters.add(crate::stats::Counter::DetailVertices, verts as u64);
-        counters.add(crate::stats::Counter::Pass1Us, t.elapsed().as_micros() as u64);
-        Ok(ShadowDatabase { samples })
+        let lit = lit_fragments(scene, light, options, counters)?;
+        let detail = |s: Vec<Lit>| s.into_par_iter().map(|f| f.into_detail(scene)).collect();
+        Ok(ShadowDatabase { samples: lit.into_iter().map(detail).collect() })
     }
 
     /// Writes the database as an OBJ file: one group per detail polygon, named after its
@@ -1293,86 +1368,89 @@ impl<'a> AthertonWeilerGreenberg<'a> {
         options: AthertonWeilerGreenbergOptions,
         counters: &mut Counters,
     ) -> Result<Self> {
-        let mut databases: Arc<Vec<ShadowDatabase>> = match &ctx.awg_database {
-            Some(db) if db.len() == ctx.scene.lights.len() => db.clone(),
+        let mut detail = Vec::new();
+        match &ctx.awg_database {
+            Some(db) if db.len() == ctx.scene.lights.len() => {
+                for polys in db.iter().flat_map(|d| &d.samples) {
+                    let (wholes, screen) = through_camera(ctx, polys);
+                    detail.push(overlay(ctx, &wholes, screen, counters));
+                }
+            }
             Some(_) => {
                 return Err(Error::InvalidOption("the shadow database does not match the scene's lights".into()))
             }
             None => {
                 // The lights are independent: built side by side, one light's last cube face
                 // overlaps the next light's work. Counters are merged in light order.
-                let built: Vec<(ShadowDatabase, Counters)> = (0..ctx.scene.lights.len())
+                let built: Vec<(Vec<Vec<Lit>>, Counters)> = (0..ctx.scene.lights.len())
                     .into_par_iter()
                     .with_max_len(1)
                     .map(|l| {
                         let mut c = Counters::default();
-                        Ok((ShadowDatabase::build(ctx.scene, l, options, &mut c)?, c))
+                        Ok((lit_fragments(ctx.scene, l, options, &mut c)?, c))
                     })
                     .collect::<Result<_>>()?;
-                let mut databases = Vec::with_capacity(built.len());
-                for (db, c) in built {
+                for (samples, c) in built {
                     counters.merge(&c);
-                    databases.push(db);
+                    for polys in samples {
+                        let (wholes, screen) = through_camera(ctx, &polys);
+                        // Fragments built for this frame alone go once they are through the
+                        // camera, before the overlay is made.
+                        crate::pieces::let_go(polys);
+                        detail.push(overlay(ctx, &wholes, screen, counters));
+                    }
                 }
-                Arc::new(databases)
-            }
-        };
-        let view = ctx.view;
-        let mut detail = Vec::new();
-        for l in 0..databases.len() {
-            for s in 0..databases[l].samples.len() {
-                let polys = &databases[l].samples[s];
-                // Through the camera in parallel, into the overlay in order.
-                // A detail polygon that is its whole source polygon (ours) covers every run
-                // on it: it needs no edges (but is drawn with them for `--debug`).
-                let whole: Vec<bool> = polys
-                    .par_iter()
-                    .map(|d| {
-                        !ctx.keep_outlines
-                            && matches!(&d.rings[..], [r] if r[..] == *ctx.scene.verts(d.source as usize))
-                    })
-                    .collect();
-                let seen =
-                    |(d, &whole): &(&DetailPolygon, &bool), want: bool| whole == want && ctx.visible[d.source as usize];
-                let wholes: Vec<u32> =
-                    polys.par_iter().zip(&whole).filter(|p| seen(p, true)).map(|(d, _)| d.source).collect();
-                let screen: Vec<(u32, Vec<Vec<DVec2>>)> = polys
-                    .par_iter()
-                    .zip(&whole)
-                    .filter(|p| seen(p, false))
-                    .map(|(d, _)| d)
-                    .map_init(
-                        || ([Vec::new(), Vec::new()], Vec::new()),
-                        |(scratch, ring), d| {
-                            let mut rings = Vec::new();
-                            for r in &d.rings {
-                                if view.clip_project(r, scratch, ring) {
-                                    rings.push(ring.clone());
-                                }
-                            }
-                            (d.source, rings)
-                        },
-                    )
-                    .collect();
-                // A database built for this frame alone lets each sample's detail polygons go
-                // once they are through the camera, before its overlay is made.
-                if let Some(databases) = Arc::get_mut(&mut databases) {
-                    crate::pieces::let_go(std::mem::take(&mut databases[l].samples[s]));
-                }
-                // Grouped by source polygon, in the order sources first come, by all threads
-                // (a hash map filled on one thread was a serial tenth of s3's preparation);
-                // each source's edge table is built on its own, in parallel.
-                let receivers = grouped_by_source(&screen);
-                let rings_of = |&i: &u32| screen[i as usize].1.as_slice();
-                let mut overlay = Overlay::from_receivers(view.height, ctx.keep_outlines, &receivers, rings_of);
-                overlay.add_wholes(&wholes);
-                counters.add(crate::stats::Counter::DetailPolygonsInView, overlay.len() as u64);
-                detail.push(overlay);
-                crate::pieces::let_go(screen);
             }
         }
         Ok(AthertonWeilerGreenberg { ctx, detail })
     }
+}
+
+/// Fragments on screen: each one's source and its outlines.
+type OnScreen = Vec<(u32, Vec<Vec<DVec2>>)>;
+
+/// One sample's lit fragments through the camera, in parallel: the sources of those seen that
+/// are whole polygons, and the others' outlines on screen with their sources. A fragment that
+/// is its whole source polygon (ours) covers every run on it: it needs no edges (but is drawn
+/// with them for `--debug`).
+fn through_camera<F: Fragment>(ctx: &ShadowContext, polys: &[F]) -> (Vec<u32>, OnScreen) {
+    let scene = ctx.scene;
+    let whole: Vec<bool> = polys.par_iter().map(|d| !ctx.keep_outlines && d.whole(scene)).collect();
+    let seen = |(d, &whole): &(&F, &bool), want: bool| whole == want && ctx.visible[d.source() as usize];
+    let wholes = polys.par_iter().zip(&whole).filter(|p| seen(p, true)).map(|(d, _)| d.source()).collect();
+    let screen = polys
+        .par_iter()
+        .zip(&whole)
+        .filter(|p| seen(p, false))
+        .map(|(d, _)| d)
+        .map_init(
+            || ([Vec::new(), Vec::new()], Vec::new()),
+            |(scratch, ring), d| {
+                let mut rings = Vec::new();
+                for r in d.rings(scene) {
+                    if ctx.view.clip_project(r, scratch, ring) {
+                        rings.push(ring.clone());
+                    }
+                }
+                (d.source(), rings)
+            },
+        )
+        .collect();
+    (wholes, screen)
+}
+
+/// One sample's overlay of the fragments [`through_camera`] gave.
+fn overlay(ctx: &ShadowContext, wholes: &[u32], screen: OnScreen, counters: &mut Counters) -> Overlay {
+    // Grouped by source polygon, in the order sources first come, by all threads (a hash
+    // map filled on one thread was a serial tenth of s3's preparation); each source's edge
+    // table is built on its own, in parallel.
+    let receivers = grouped_by_source(&screen);
+    let rings_of = |&i: &u32| screen[i as usize].1.as_slice();
+    let mut overlay = Overlay::from_receivers(ctx.view.height, ctx.keep_outlines, &receivers, rings_of);
+    overlay.add_wholes(wholes);
+    counters.add(crate::stats::Counter::DetailPolygonsInView, overlay.len() as u64);
+    crate::pieces::let_go(screen);
+    overlay
 }
 
 /// The detail polygons on screen with outlines (their places in `screen`), grouped by
