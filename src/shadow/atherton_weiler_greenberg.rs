@@ -942,17 +942,13 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
     // polygon is mapped once a view: a source's place is read from `place`): worked out in
     // parallel, in order.
     let sheet = |p: &MappedPolygon| p.casts && p.whole;
-    let place = places(m, &kept, scene.polygons.len());
-    let local = |q: u32| match place.get(q as usize) {
-        Some(&k) if k != NO_ITEM && sheet(&m.polys[kept[k as usize]]) => k,
-        _ => NO_ITEM,
-    };
+    let place = SheetPlaces::new(m, &kept, sheet, scene.polygons.len());
     let across: Vec<u32> = kept
         .par_iter()
         .map(|&i| &m.polys[i])
         .filter(|p| sheet(p))
         .flat_map_iter(|p| scene.across(p.source as usize).iter())
-        .map(|&q| local(q))
+        .map(|&q| place.get(q))
         .collect();
     let edges_of = |&i: &usize| if sheet(&m.polys[i]) { m.polys[i].len as usize } else { 0 };
     let first = pieces::starts(kept.iter().map(edges_of));
@@ -978,25 +974,45 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
             Piece::new(p.source, Region { rings }, p.near)
         })
         .collect();
-    // By all threads: a kept polygon's place among the kept is read from `place`.
-    let lone_at = |i: usize| found.lone[place[m.polys[i].source as usize] as usize];
-    let sorted: Vec<bool> = (0..n).into_par_iter().map(|i| !behind[i] && !lone_at(i)).collect();
+    let lone_at = pieces::marked(n, kept.par_iter().zip(&found.lone).filter(|(_, &l)| l).map(|(&i, _)| i));
+    let sorted: Vec<bool> = (0..n).into_par_iter().map(|i| !behind[i] && !lone_at[i]).collect();
     let lone = kept.par_iter().zip(&found.lone).filter(|(_, &l)| l).map(|(&i, _)| m.polys[i].source).collect();
     let behind = (0..n).into_par_iter().filter(|&i| behind[i]).filter_map(|i| m.piece(&m.polys[i])).collect();
     LoneSplit { lone, outlines, behind, sorted }
 }
 
-/// `place[s]`: the place among `kept` (indices into `m.polys`) of the polygon mapped from
-/// scene polygon `s` (of the scene's `polygons`), [`NO_ITEM`] for the others; a view maps a
-/// polygon at most once. Written by all threads: three million bisections over the kept
-/// polygons' sources, one for each edge of every whole caster, were a third of s3's lone-sheet
-/// step on one thread.
-fn places(m: &Mapped, kept: &[usize], polygons: usize) -> Vec<u32> {
-    use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
-    let mut place = Vec::new();
-    place.par_extend((0..polygons).into_par_iter().map(|_| AtomicU32::new(NO_ITEM)));
-    kept.par_iter().enumerate().for_each(|(k, &i)| place[m.polys[i].source as usize].store(k as u32, Relaxed));
-    place.into_par_iter().map(AtomicU32::into_inner).collect()
+/// The places among `kept` (indices into `m.polys`) of the sheet polygons (`sheet`), by the
+/// scene polygon each is mapped from (a view maps a polygon at most once); [`NO_ITEM`] for any
+/// other polygon. One list as long as the scene's polygons, written by all threads, where the
+/// view holds many of them (three million bisections over the kept polygons' sources, one
+/// for each edge of every whole caster, were a third of s3's lone-sheet step on one thread);
+/// a hash map where it holds few (the list cost each of s3's five nearly empty cube faces
+/// 3 ms).
+enum SheetPlaces {
+    Listed(Vec<u32>),
+    Hashed(FxHashMap<u32, u32>),
+}
+
+impl SheetPlaces {
+    fn new(m: &Mapped, kept: &[usize], sheet: impl Fn(&MappedPolygon) -> bool + Sync, polygons: usize) -> Self {
+        use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+        let sheets = kept.par_iter().enumerate().filter(|&(_, &i)| sheet(&m.polys[i]));
+        if kept.len() * 16 < polygons {
+            return SheetPlaces::Hashed(sheets.map(|(k, &i)| (m.polys[i].source, k as u32)).collect());
+        }
+        let mut place = Vec::new();
+        place.par_extend((0..polygons).into_par_iter().map(|_| AtomicU32::new(NO_ITEM)));
+        sheets.for_each(|(k, &i)| place[m.polys[i].source as usize].store(k as u32, Relaxed));
+        SheetPlaces::Listed(place.into_par_iter().map(AtomicU32::into_inner).collect())
+    }
+
+    /// The place of scene polygon `s`, if it is a sheet polygon of the view.
+    fn get(&self, s: u32) -> u32 {
+        match self {
+            SheetPlaces::Listed(place) => place.get(s as usize).copied().unwrap_or(NO_ITEM),
+            SheetPlaces::Hashed(place) => place.get(&s).copied().unwrap_or(NO_ITEM),
+        }
+    }
 }
 
 /// Most wide polygons a light view tries as backgrounds.
@@ -1227,13 +1243,13 @@ fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> 
     for &i in &order {
         let a = &casters[i];
         active.retain(|&k| casters[k].bounds.1.x >= a.bounds.0.x);
-        for &k in &active {
+        for &k in active.iter().filter(|&&k| a.overlaps(&casters[k])) {
             let b = &casters[k];
-            // Whether the pair would clear either flag, asked before the dearer question
-            // whether their insides meet at all.
+            // Whether the pair would clear either flag, asked (once their boxes meet) before
+            // the dearer question whether their insides meet at all.
             let clears_i = back[i] && !matches!(relation(b, a), Relation::Front);
             let clears_k = back[k] && !matches!(relation(a, b), Relation::Front);
-            if (clears_i || clears_k) && a.overlaps(b) && !regions_apart(&a.region, &b.region) {
+            if (clears_i || clears_k) && !regions_apart(&a.region, &b.region) {
                 back[i] &= !clears_i;
                 back[k] &= !clears_k;
             }
