@@ -170,6 +170,16 @@ pub struct EdgeTable {
     in_place: bool,
 }
 
+/// Empties `list` and gives it room for `n` items. A list short of room takes a new buffer:
+/// growing the old one would copy its stale items (the bands' edge tables, each as long as
+/// the longest band before it, did so at every band).
+fn emptied_with_room<T>(list: &mut Vec<T>, n: usize) {
+    list.clear();
+    if list.capacity() < n {
+        *list = Vec::with_capacity(n);
+    }
+}
+
 /// The edges of the closed `ring` of polygon `tag`, in order, in an image `height` lines
 /// high, cut to the lines `within` if given.
 fn ring_edges<'a>(
@@ -241,6 +251,14 @@ impl EdgeTable {
     pub fn clear_to(&mut self, height: u32, lines: Range<u32>) {
         self.clear(height);
         self.within = Some(lines);
+    }
+
+    /// Makes room for `edges` more edges (without copying stale ones, when it is empty).
+    pub(crate) fn reserve(&mut self, edges: usize) {
+        if self.edges.is_empty() {
+            emptied_with_room(&mut self.edges, edges);
+        }
+        self.edges.reserve(edges);
     }
 
     /// Adds the edges of a closed ring of polygon `tag`. Rings of one tag combine by the
@@ -415,7 +433,7 @@ impl EdgeTable {
             self.bucket[i + 1] += self.bucket[i];
         }
         let mut sorted = std::mem::take(&mut self.spare);
-        sorted.clear();
+        emptied_with_room(&mut sorted, self.edges.len());
         // A fresh list of millions of edges is first touched here: in parallel, its pages
         // are found and zeroed by every thread.
         if parallel {

@@ -110,8 +110,13 @@ impl<'a> ScanlineVisibility<'a> {
         let members = self.members_of(lines);
         let BandScratch { table, planes, polys, set } = scratch;
         table.clear_to(self.height, lines.clone());
+        // Room for every member's edges at once (a ring gives at most one edge a corner):
+        // grown edge by edge, the table's reallocations were 2% of s3's frame.
+        table.reserve(members.iter().map(|&i| self.screen.get(i).1.len()).sum());
         planes.clear();
         polys.clear();
+        planes.reserve(members.len());
+        polys.reserve(members.len());
         for (k, &i) in members.iter().enumerate() {
             let (p, ring) = self.screen.get(i);
             table.add_ring(k as u32, ring);
