@@ -637,11 +637,20 @@ impl LightView {
                     &|p| p.dot(axis) - near,
                 ];
                 // Most polygons lie wholly outside some side of a face's frustum: they are
-                // dropped before they are copied.
-                if planes.iter().any(|f| verts.iter().all(|&v| f(v - light) < 0.0)) {
+                // dropped before they are copied. Each corner is put in the face's frame
+                // once, and the sides read from it (the values `planes` give).
+                let (mut outside, mut whole) = ([true; 5], true);
+                for &v in verts {
+                    let p = v - light;
+                    let (x, y, z) = (p.dot(e1), p.dot(e2), p.dot(axis));
+                    for (out, side) in outside.iter_mut().zip([z - x, z + x, z - y, z + y, z - near]) {
+                        *out &= side < 0.0;
+                        whole &= side >= 0.0;
+                    }
+                }
+                if outside.contains(&true) {
                     return None;
                 }
-                let whole = planes.iter().all(|f| verts.iter().all(|&v| f(v - light) >= 0.0));
                 let [a, b] = scratch;
                 a.clear();
                 a.extend(verts.iter().map(|&v| v - light));
