@@ -860,7 +860,7 @@ fn sphere_boxes(cone: &Cone) -> Boxes {
     if t0 <= 0.0 || t1 >= PI {
         return [Some([t0.max(0.0), -PI, t1.min(PI), PI]), None];
     }
-    let dphi = (half.sin() / theta.sin()).min(1.0).asin() + 1e-9;
+    let dphi = (cone.sin / theta.sin()).min(1.0).asin() + 1e-9;
     let (p0, p1) = (phi - dphi, phi + dphi);
     if p0 < -PI {
         [Some([t0, p0 + 2.0 * PI, t1, PI]), Some([t0, -PI, t1, p1])]
