@@ -173,7 +173,7 @@ pub struct EdgeTable {
 /// Empties `list` and gives it room for `n` items. A list short of room takes a new buffer:
 /// growing the old one would copy its stale items (the bands' edge tables, each as long as
 /// the longest band before it, did so at every band).
-fn emptied_with_room<T>(list: &mut Vec<T>, n: usize) {
+pub(crate) fn emptied_with_room<T>(list: &mut Vec<T>, n: usize) {
     list.clear();
     if list.capacity() < n {
         *list = Vec::with_capacity(n);
@@ -257,8 +257,9 @@ impl EdgeTable {
     pub(crate) fn reserve(&mut self, edges: usize) {
         if self.edges.is_empty() {
             emptied_with_room(&mut self.edges, edges);
+        } else {
+            self.edges.reserve(edges);
         }
-        self.edges.reserve(edges);
     }
 
     /// Adds the edges of a closed ring of polygon `tag`. Rings of one tag combine by the

@@ -983,8 +983,8 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
             Piece::new(p.source, Region { rings }, p.near)
         })
         .collect();
-    let lone_at = pieces::marked(n, kept.par_iter().zip(&found.lone).filter(|(_, &l)| l).map(|(&i, _)| i));
-    let sorted: Vec<bool> = (0..n).into_par_iter().map(|i| !behind[i] && !lone_at[i]).collect();
+    // What goes on to the sort: the kept polygons (all but the wide backgrounds) not lone.
+    let sorted = pieces::marked(n, kept.par_iter().zip(&found.lone).filter(|(_, &l)| !l).map(|(&i, _)| i));
     let lone = kept.par_iter().zip(&found.lone).filter(|(_, &l)| l).map(|(&i, _)| m.polys[i].source).collect();
     let behind = (0..n).into_par_iter().filter(|&i| behind[i]).filter_map(|i| m.piece(&m.polys[i])).collect();
     LoneSplit { lone, outlines, behind, sorted }

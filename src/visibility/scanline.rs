@@ -15,7 +15,7 @@
 
 use super::{push_run, Run, Visibility};
 use crate::pool::{Pools, Stash};
-use crate::scan::{band_height, boundary, ActiveEdges, EdgeTable, OpenSet};
+use crate::scan::{band_height, boundary, emptied_with_room, ActiveEdges, EdgeTable, OpenSet};
 use crate::scene::Scene;
 use crate::stats::Counters;
 use crate::view::{DepthPlane, Screen, View};
@@ -113,10 +113,8 @@ impl<'a> ScanlineVisibility<'a> {
         // Room for every member's edges at once (a ring gives at most one edge a corner):
         // grown edge by edge, the table's reallocations were 2% of s3's frame.
         table.reserve(members.iter().map(|&i| self.screen.get(i).1.len()).sum());
-        planes.clear();
-        polys.clear();
-        planes.reserve(members.len());
-        polys.reserve(members.len());
+        emptied_with_room(planes, members.len());
+        emptied_with_room(polys, members.len());
         for (k, &i) in members.iter().enumerate() {
             let (p, ring) = self.screen.get(i);
             table.add_ring(k as u32, ring);
