@@ -185,8 +185,8 @@ mod tests {
 
     #[test]
     fn a_chart_is_written_as_svg_and_as_png_with_its_text_drawn() {
-        let dir = std::env::temp_dir().join(format!("umbra-plot-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::Builder::new().prefix("umbra-plot-").tempdir().unwrap();
+        let dir = scratch.path();
         save(&Label, &dir.join("label")).unwrap();
         let svg = std::fs::read_to_string(dir.join("label.svg")).unwrap();
         assert!(svg.contains("ms 1.5"), "{svg}");
@@ -195,6 +195,5 @@ mod tests {
         // The text is drawn in dark pixels on the white background.
         let dark = png.pixels().filter(|p| p.0.iter().all(|&c| c < 128)).count();
         assert!(dark > 20, "only {dark} dark pixels: the text was not drawn");
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

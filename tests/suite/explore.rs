@@ -121,9 +121,10 @@ fn many_requests_at_once_are_all_answered_alike() {
 
 #[test]
 fn the_export_holds_every_line_of_every_applicable_stage() {
-    let dir = std::env::temp_dir().join(format!("umbra-explore-export-{}", std::process::id()));
+    let scratch = tempfile::Builder::new().prefix("umbra-explore-export-").tempdir().unwrap();
+    let dir = scratch.path();
     let explorer = Explorer::new(cornell(), "cornell");
-    export(&explorer, &dir, 64, 48, &ShadowMethod::ALL).unwrap();
+    export(&explorer, dir, 64, 48, &ShadowMethod::ALL).unwrap();
     for name in ["index.html", "explore.js", "explore.css", "data.js"] {
         assert!(dir.join(name).is_file(), "{name}");
     }
@@ -141,7 +142,6 @@ fn the_export_holds_every_line_of_every_applicable_stage() {
         assert!(lines.lines().all(|l| l.starts_with(&format!("umbraDecisions(\"{stage}\", ")) && l.ends_with("]);")));
         assert!(dir.join(format!("frames/{stage}.png")).is_file());
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The explorer's frame summary carries seed 000's penumbra of the first area light (the

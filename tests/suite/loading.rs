@@ -53,11 +53,11 @@ fn unreadable_mesh() {
 
 #[test]
 fn bad_obj_line_names_the_obj_file() {
-    let dir = std::env::temp_dir().join(format!("umbra-load-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = tempfile::Builder::new().prefix("umbra-load-").tempdir().unwrap();
+    let dir = scratch.path();
     std::fs::write(dir.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").unwrap();
     let src = format!("{CAMERA}[[object]]\nmesh = \"m.obj\"\n");
-    let e = Scene::from_toml(&src, dir.join("s.toml"), &dir).unwrap_err().to_string();
+    let e = Scene::from_toml(&src, dir.join("s.toml"), dir).unwrap_err().to_string();
     assert!(e.ends_with("m.obj:4: vertex index 4 out of range (3 defined so far)"), "{e}");
 }
 
@@ -142,8 +142,8 @@ fn ranged_keys_name_themselves_and_their_line() {
 
 #[test]
 fn byte_order_marks_and_bad_encodings() {
-    let dir = std::env::temp_dir().join(format!("umbra-bom-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = tempfile::Builder::new().prefix("umbra-bom-").tempdir().unwrap();
+    let dir = scratch.path();
     std::fs::write(dir.join("m.obj"), "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let scene = format!("\u{feff}{CAMERA}[[object]]\nmesh = \"m.obj\"\n");
     std::fs::write(dir.join("s.toml"), &scene).unwrap();
@@ -154,7 +154,6 @@ fn byte_order_marks_and_bad_encodings() {
     std::fs::write(dir.join("bad.toml"), &bad).unwrap();
     let e = Scene::load(dir.join("bad.toml")).unwrap_err().to_string();
     assert!(e.contains("bad.toml:6") && e.contains("not UTF-8"), "{e}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

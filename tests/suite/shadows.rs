@@ -371,8 +371,8 @@ fn one_shadow_database_serves_many_views() {
 #[test]
 fn random_solids_with_lights_inside_on_and_around() {
     use rand::{Rng, SeedableRng};
-    let dir = std::env::temp_dir().join(format!("umbra-solids-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = tempfile::Builder::new().prefix("umbra-solids-").tempdir().unwrap();
+    let dir = scratch.path();
     let mut in_shadow = 0;
     for seed in 0..120u64 {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
@@ -421,12 +421,11 @@ fn random_solids_with_lights_inside_on_and_around() {
             v3(light),
             poly(&star)
         );
-        let scene = Scene::from_toml(&src, std::path::Path::new("solid.toml"), &dir).unwrap_or_else(|e| panic!("{e}"));
+        let scene = Scene::from_toml(&src, std::path::Path::new("solid.toml"), dir).unwrap_or_else(|e| panic!("{e}"));
         let (_, s) = check(&scene, &format!("solid seed {seed}"));
         in_shadow += s;
     }
     assert!(in_shadow > 120 * 200, "only {in_shadow} pixels in shadow");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Bouknight-Kelley counts a closed solid's shadow polygons on a receiver under many of

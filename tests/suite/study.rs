@@ -4,13 +4,9 @@ use std::path::Path;
 use umbra::study::compare::{compare, CompareOptions};
 use umbra::{Scene, ShadowMethod};
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("umbra-study-{}-{name}", std::process::id()));
-    // Fresh: a folder left by an earlier run whose process had the same id would hold
-    // files that the commands refuse to overwrite.
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh folder for one test, removed when the test is done with it.
+fn tmp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("umbra-study-{name}-")).tempdir().unwrap()
 }
 
 #[test]
@@ -30,8 +26,9 @@ fn compare_reports_every_method_and_a_valid_page() {
         c.height = 120;
         scene.set_camera(c).expect("a valid camera");
     }
-    let out = tmp("compare");
-    let opts = CompareOptions { runs: 1, out: out.clone(), ..CompareOptions::default() };
+    let out_dir = tmp("compare");
+    let out = out_dir.path();
+    let opts = CompareOptions { runs: 1, out: out.to_path_buf(), ..CompareOptions::default() };
     let report = compare(&scene, "lights", &opts, |_| {}).unwrap();
     assert_eq!(report.results.len(), umbra::VisibilityMethod::ALL.len() * ShadowMethod::ALL.len());
     for r in &report.results {
@@ -184,12 +181,13 @@ fn quads_sweep(
 )]
 fn scale_writes_csv_and_plots() {
     use umbra::study::scale::scale;
-    let out = tmp("scale");
+    let out_dir = tmp("scale");
+    let out = out_dir.path();
     let methods = vec![
         (umbra::VisibilityMethod::Scanline, ShadowMethod::None),
         (umbra::VisibilityMethod::ZBuffer, ShadowMethod::None),
     ];
-    let points = scale(&quads_sweep(&out, vec![1.0, 4.0, 16.0], methods)).unwrap();
+    let points = scale(&quads_sweep(out, vec![1.0, 4.0, 16.0], methods)).unwrap();
     assert_eq!(points.len(), 6);
     // The z-buffer tests every covered pixel once per polygon: its depth tests grow with depth
     // complexity, about 160×90 per quad.
@@ -221,9 +219,10 @@ fn scale_writes_csv_and_plots() {
     ignore = "it checks the charts: run with the `plots` feature, as `cargo test` at the top does"
 )]
 fn the_scale_legend_holds_its_longest_method_name() {
-    let out = tmp("scale-legend");
+    let out_dir = tmp("scale-legend");
+    let out = out_dir.path();
     let methods = vec![(umbra::VisibilityMethod::Scanline, "atherton-weiler-greenberg".parse().unwrap())];
-    umbra::study::scale::scale(&quads_sweep(&out, vec![1.0, 4.0], methods)).unwrap();
+    umbra::study::scale::scale(&quads_sweep(out, vec![1.0, 4.0], methods)).unwrap();
     let png = image::open(out.join("time.png")).unwrap().to_rgb8();
     // The legend's one entry, "scanline + atherton-weiler-greenberg", is drawn near the top:
     // its last dark pixel must stand clear of the image's right edge.
@@ -251,13 +250,14 @@ fn unknown_method_names_list_the_known_ones() {
     ignore = "it checks the charts: run with the `plots` feature, as `cargo test` at the top does"
 )]
 fn scale_notes_series_of_equal_values() {
-    let out = tmp("scale-equal");
+    let out_dir = tmp("scale-equal");
+    let out = out_dir.path();
     let methods = vec![
         (umbra::VisibilityMethod::Scanline, ShadowMethod::None),
         (umbra::VisibilityMethod::Scanline, "crow".parse().unwrap()),
         (umbra::VisibilityMethod::ZBuffer, ShadowMethod::None),
     ];
-    umbra::study::scale::scale(&quads_sweep(&out, vec![1.0, 4.0], methods)).unwrap();
+    umbra::study::scale::scale(&quads_sweep(out, vec![1.0, 4.0], methods)).unwrap();
     let svg = std::fs::read_to_string(out.join("counter.svg")).unwrap();
     assert!(svg.contains("scanline + crow (equal to 1, on its line)"), "the note is missing");
     assert!(!svg.contains("zbuffer + none (equal"), "the z-buffer's depth tests differ");
@@ -275,7 +275,8 @@ fn scale_notes_series_of_equal_values() {
 )]
 fn the_samples_sweep_measures_the_grid_against_the_exact_fraction() {
     use umbra::study::scale::{scale, Sweep};
-    let out = tmp("scale-samples");
+    let out_dir = tmp("scale-samples");
+    let out = out_dir.path();
     let methods = vec![
         (umbra::VisibilityMethod::Scanline, ShadowMethod::Crow(Default::default())),
         (umbra::VisibilityMethod::Scanline, ShadowMethod::NishitaNakamae(Default::default())),
@@ -283,7 +284,7 @@ fn the_samples_sweep_measures_the_grid_against_the_exact_fraction() {
     let opts = umbra::study::scale::ScaleOptions {
         sweep: Sweep::Samples,
         counter: "shadow.pairs".into(),
-        ..quads_sweep(&out, vec![1.0, 4.0, 8.0], methods)
+        ..quads_sweep(out, vec![1.0, 4.0, 8.0], methods)
     };
     let points = scale(&opts).unwrap();
     let error = |shadows: &str| -> Vec<f64> {
@@ -300,12 +301,13 @@ fn the_samples_sweep_measures_the_grid_against_the_exact_fraction() {
 #[test]
 fn a_sweep_point_over_the_budget_is_refused_and_the_sweep_goes_on() {
     use umbra::study::scale::{scale, Sweep};
-    let out = tmp("scale-refused");
+    let out_dir = tmp("scale-refused");
+    let out = out_dir.path();
     let williams = (umbra::VisibilityMethod::Scanline, ShadowMethod::Williams(Default::default()));
     let opts = umbra::study::scale::ScaleOptions {
         sweep: Sweep::Samples,
         counter: "shadow.map_lookups".into(),
-        ..quads_sweep(&out, vec![1.0, 12.0], vec![williams])
+        ..quads_sweep(out, vec![1.0, 12.0], vec![williams])
     };
     let points = scale(&opts).unwrap();
     assert!(points[0].refused.is_none() && points[0].time.median_ms > 0.0);

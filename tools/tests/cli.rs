@@ -7,18 +7,15 @@ fn umbra() -> Command {
     Command::new(env!("CARGO_BIN_EXE_umbra"))
 }
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("umbra-cli-{}-{name}", std::process::id()));
-    // Fresh: a folder left by an earlier run whose process had the same id would hold
-    // files that the commands refuse to overwrite.
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh folder for one test, removed when the test is done with it.
+fn tmp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("umbra-cli-{name}-")).tempdir().unwrap()
 }
 
 #[test]
 fn render_writes_image_aovs_and_stats() {
-    let d = tmp("render");
+    let d_dir = tmp("render");
+    let d = d_dir.path();
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/lights.toml");
     let out = umbra()
         .args(["render", scene, "-o"])
@@ -72,7 +69,8 @@ fn stats_give_a_shadow_maps_errors_by_cause() {
 
 #[test]
 fn bad_input_is_one_line_and_non_zero() {
-    let d = tmp("bad");
+    let d_dir = tmp("bad");
+    let d = d_dir.path();
     let bad = d.join("bad.toml");
     std::fs::write(&bad, "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nzoom = 2\n").unwrap();
     let out = umbra().arg("render").arg(&bad).arg("-o").arg(d.join("o.png")).output().unwrap();
@@ -100,7 +98,8 @@ fn bad_input_is_one_line_and_non_zero() {
 
 #[test]
 fn generate_writes_a_loadable_scene() {
-    let d = tmp("gen");
+    let d_dir = tmp("gen");
+    let d = d_dir.path();
     let out = umbra()
         .args(["generate", "cubes", "--n", "2", "--width", "64", "--height", "48", "-o"])
         .arg(d.join("c.toml"))
@@ -115,7 +114,8 @@ fn generate_writes_a_loadable_scene() {
 
 #[test]
 fn export_shadows_writes_an_obj_of_lit_detail_polygons() {
-    let d = tmp("export");
+    let d_dir = tmp("export");
+    let d = d_dir.path();
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.toml");
     let out = umbra().args(["export-shadows", scene, "-o"]).arg(d.join("lit.obj")).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -180,7 +180,8 @@ fn options_are_checked_wherever_they_are_used() {
     refused(&[&["trace", SMALL, "--line", "3", "--map-size", "0"][..], &w].concat(), "map size 0");
     refused(&[&["trace", SMALL, "--line", "3", "--pcf-size", "2"][..], &w].concat(), "kernel size 2");
     refused(&[&["trace", SMALL, "--line", "3", "--bias", "nan"][..], &w].concat(), "bias");
-    let d = tmp("compare-map");
+    let d_dir = tmp("compare-map");
+    let d = d_dir.path();
     let out = d.join("c");
     refused(
         &["compare", SMALL, "--shadows", "williams", "--map-size", "0", "--out", out.to_str().unwrap()],
@@ -203,7 +204,8 @@ fn options_are_checked_wherever_they_are_used() {
 
 #[test]
 fn work_beyond_the_memory_budget_is_refused_before_it_starts() {
-    let d = tmp("budget");
+    let d_dir = tmp("budget");
+    let d = d_dir.path();
     let big = d.join("big.toml");
     std::fs::write(
         &big,
@@ -306,7 +308,8 @@ fn bench_compares_thread_counts_frame_by_frame() {
 /// writes a viewable face-id image beside the packed one.
 #[test]
 fn nothing_silent() {
-    let d = tmp("silent");
+    let d_dir = tmp("silent");
+    let d = d_dir.path();
     let g = d.join("g.toml");
     let gen = ["generate", "cubes", "--n", "1", "--width", "32", "--height", "24", "-o", g.to_str().unwrap()];
     let (ok, err) = run(&gen);
@@ -339,7 +342,8 @@ fn nothing_silent() {
 #[test]
 fn receiver_makes_planar_shadows_usable_on_any_scene() {
     let cornell = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.toml");
-    let d = tmp("receiver");
+    let d_dir = tmp("receiver");
+    let d = d_dir.path();
     let out = d.join("planar.png");
     let out = out.to_str().unwrap();
     refused(&["render", cornell, "--shadows", "planar", "-o", out], "receiver");
@@ -370,7 +374,8 @@ fn receiver_makes_planar_shadows_usable_on_any_scene() {
 /// the fix, in place of zero times and errors.
 #[test]
 fn printed_tables_have_headers_and_say_not_applicable() {
-    let d = tmp("tables");
+    let d_dir = tmp("tables");
+    let d = d_dir.path();
     let out = umbra()
         .args([
             "compare",
@@ -417,7 +422,8 @@ fn printed_tables_have_headers_and_say_not_applicable() {
 /// cannot be made the message says the write failed.
 #[test]
 fn output_folders_are_made_and_failed_writes_say_so() {
-    let d = tmp("folders");
+    let d_dir = tmp("folders");
+    let d = d_dir.path();
     let png = d.join("new/deeper/o.png");
     let out = umbra().args(["render", SMALL, "-o"]).arg(&png).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -428,7 +434,8 @@ fn output_folders_are_made_and_failed_writes_say_so() {
 /// A negative image size is named with the range, like any other bad size, not as a type.
 #[test]
 fn a_negative_size_is_named_with_its_range() {
-    let d = tmp("negative");
+    let d_dir = tmp("negative");
+    let d = d_dir.path();
     let bad = d.join("neg.toml");
     std::fs::write(&bad, "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nwidth = -5\n").unwrap();
     let out = umbra().arg("render").arg(&bad).arg("-o").arg(d.join("o.png")).output().unwrap();
@@ -442,7 +449,8 @@ fn a_negative_size_is_named_with_its_range() {
 /// message says how many were written.
 #[test]
 fn generated_spheres_come_near_the_triangles_asked_for() {
-    let d = tmp("spheres");
+    let d_dir = tmp("spheres");
+    let d = d_dir.path();
     let out = umbra()
         .args(["generate", "spheres", "--triangles", "5000", "--count", "3", "-o"])
         .arg(d.join("s.toml"))
@@ -496,15 +504,14 @@ fn the_command_stops_on_a_bad_scene_before_serving() {
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("no-such-scene.toml") && !err.contains("http://"), "{err}");
 
-    let dir = std::env::temp_dir().join(format!("umbra-explore-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = tempfile::Builder::new().prefix("umbra-explore-cli-").tempdir().unwrap();
+    let dir = scratch.path();
     std::fs::write(dir.join("keep.txt"), "mine").unwrap();
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.toml");
-    let out = umbra().args(["explore", scene, "--export"]).arg(&dir).output().unwrap();
+    let out = umbra().args(["explore", scene, "--export"]).arg(dir).output().unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("pass --force"));
-    let out = umbra().args(["explore", scene, "--size", "9999x10", "--export"]).arg(&dir).output().unwrap();
+    let out = umbra().args(["explore", scene, "--size", "9999x10", "--export"]).arg(dir).output().unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("WIDTHxHEIGHT"));
-    std::fs::remove_dir_all(&dir).unwrap();
 }
