@@ -571,23 +571,38 @@ impl Wedge {
 /// An extent's boxes in the 2D domain of the [`SphereGrid`] (two when the azimuth wraps).
 type Boxes = [Option<[f64; 4]>; 2];
 
-/// A bounding cone from the light: its axis, its half-angle, and the half-angle's cosine
-/// and sine, so that cones are compared without an arccosine per pair. Kept apart from the
-/// boxes, in a list the pair loop reads at random, so that a caster's cone is one read.
+/// A bounding cone from the light: its axis and its half-angle's cosine and sine, so that
+/// cones are compared, and their boxes on the sphere found, without an arccosine, a sine or
+/// a cosine per polygon (ours). A half-angle of 90° or more is the whole sphere (a negative
+/// cosine). Kept apart from the boxes, in a list the pair loop reads at random, so that a
+/// caster's cone is one read.
 #[derive(Debug, Clone, Copy)]
 struct Cone {
     axis: DVec3,
-    half: f64,
     cos: f64,
     sin: f64,
 }
 
 impl Cone {
     /// The cone of a polygon that is neither caster nor receiver (never asked about).
-    const NONE: Cone = Cone { axis: DVec3::Y, half: 0.0, cos: 1.0, sin: 0.0 };
+    const NONE: Cone = Cone { axis: DVec3::Y, cos: 1.0, sin: 0.0 };
+    /// The whole sphere.
+    const WHOLE: Cone = Cone { axis: DVec3::Y, cos: -1.0, sin: 0.0 };
 
-    fn new(axis: DVec3, half: f64) -> Cone {
-        Cone { axis, half, cos: half.cos(), sin: half.sin() }
+    /// The cone around `axis` whose half-angle has cosine `cos` (in `0..=1`); the sine is
+    /// taken as `sqrt((1 − cos)(1 + cos))`, where `1 − cos` is exact for a cosine above ½.
+    fn new(axis: DVec3, cos: f64) -> Cone {
+        Cone { axis, cos, sin: ((1.0 - cos) * (1.0 + cos)).sqrt() }
+    }
+
+    fn whole(&self) -> bool {
+        self.cos < 0.0
+    }
+
+    /// An upper bound on the half-angle, for a cone that is not the whole sphere: its
+    /// tangent (which exceeds the angle below 90°), at most 90°.
+    fn half_bound(&self) -> f64 {
+        (self.sin / self.cos).min(PI / 2.0)
     }
 }
 
@@ -642,7 +657,7 @@ impl Extents {
     fn overlap(&self, a: u32, b: u32) -> bool {
         if self.point() {
             let (ac, bc) = (self.cones[a as usize], self.cones[b as usize]);
-            return ac.half + bc.half >= PI || ac.axis.dot(bc.axis) >= ac.cos * bc.cos - ac.sin * bc.sin - 1e-12;
+            return ac.whole() || bc.whole() || ac.axis.dot(bc.axis) >= ac.cos * bc.cos - ac.sin * bc.sin - 1e-12;
         }
         let (p, q) = (self.boxes[a as usize], self.boxes[b as usize]);
         p[0] <= q[2] && q[0] <= p[2] && p[1] <= q[3] && q[1] <= p[3]
@@ -830,39 +845,46 @@ fn plane_box(verts: &[DVec3], d: DVec3) -> [f64; 4] {
 
 /// The bounding cone, from a point light at `s`, of the directions to `verts` (a polygon's
 /// directions all lie inside a cone of half-angle under 90° that holds its vertices'
-/// directions; the whole sphere where they do not fit in one).
+/// directions; the whole sphere where they do not fit in one). The least cosine between the
+/// axis and a vertex direction, less a hair so that rounding can only widen the cone, is the
+/// half-angle's cosine.
 fn cone(verts: &[DVec3], s: DVec3) -> Cone {
-    let full = Cone::new(DVec3::Y, PI);
     let dirs: smallvec::SmallVec<[DVec3; 8]> = verts.iter().map(|&v| (v - s).normalize_or_zero()).collect();
     let axis = dirs.iter().sum::<DVec3>().normalize_or_zero();
     if axis == DVec3::ZERO || dirs.contains(&DVec3::ZERO) {
-        return full;
+        return Cone::WHOLE;
     }
-    // The widest vertex direction's angle: the arccosine of the least cosine.
-    let least = dirs.iter().map(|d| d.dot(axis)).fold(1.0, f64::min).clamp(-1.0, 1.0);
-    let half = least.acos() + 1e-9;
-    if half >= PI / 2.0 {
-        return full;
+    let least = dirs.iter().map(|d| d.dot(axis)).fold(1.0, f64::min).min(1.0) - 1e-12;
+    if least <= 0.0 {
+        return Cone::WHOLE;
     }
-    Cone::new(axis, half)
+    Cone::new(axis, least)
 }
 
 /// A cone's boxes in polar angle θ (from +Y) and azimuth φ (two where the azimuth wraps;
-/// the whole domain for the whole sphere).
+/// the whole domain for the whole sphere). They hold the cone: its half-angle is bounded
+/// above by [`Cone::half_bound`], and its azimuth's half-width `asin(sin h / sin θ)` by
+/// `x / sqrt(1 − x²)` of `x = sin h / sin θ` (the tangent of that arcsine; the whole circle
+/// from `x` = 1).
 fn sphere_boxes(cone: &Cone) -> Boxes {
-    let (axis, half) = (cone.axis, cone.half);
-    if half >= PI / 2.0 {
+    if cone.whole() {
         return [Some([0.0, -PI, PI, PI]), None];
     }
+    let (axis, half) = (cone.axis, cone.half_bound());
     let theta = axis.y.clamp(-1.0, 1.0).acos();
     let phi = axis.z.atan2(axis.x);
     let (t0, t1) = (theta - half, theta + half);
-    if t0 <= 0.0 || t1 >= PI {
+    // sin θ from the axis itself, where the pole does not come within the cone.
+    let sin_theta = axis.x.hypot(axis.z);
+    let x = cone.sin / sin_theta;
+    if t0 <= 0.0 || t1 >= PI || x.is_nan() || x >= 1.0 {
         return [Some([t0.max(0.0), -PI, t1.min(PI), PI]), None];
     }
-    let dphi = (cone.sin / theta.sin()).min(1.0).asin() + 1e-9;
+    let dphi = (x / ((1.0 - x) * (1.0 + x)).sqrt()).min(PI) + 1e-9;
     let (p0, p1) = (phi - dphi, phi + dphi);
-    if p0 < -PI {
+    if dphi >= PI {
+        [Some([t0, -PI, t1, PI]), None]
+    } else if p0 < -PI {
         [Some([t0, p0 + 2.0 * PI, t1, PI]), Some([t0, -PI, t1, p1])]
     } else if p1 > PI {
         [Some([t0, p0, t1, PI]), Some([t0, -PI, t1, p1 - 2.0 * PI])]
