@@ -57,6 +57,11 @@ pub struct ShadowDatabase {
     pub samples: Vec<Vec<DetailPolygon>>,
 }
 
+/// One light sample's lit fragments as pass 1 makes them: a list for each of its light views
+/// (a point sample's cube faces), in order, never copied into one list (ours: on s3 the
+/// copy, 470,000 fragments, was a fresh list's pages written by one thread each frame).
+type Faces = Vec<Vec<Lit>>;
+
 /// A lit fragment as pass 1 makes it (ours): a source polygon lit whole is its index alone,
 /// with no copy of its outline. On s3 nine in ten fragments are whole (the lone sheets'
 /// polygons); the public [`ShadowDatabase`] spells them out as [`DetailPolygon`]s.
@@ -1297,7 +1302,7 @@ fn lit_fragments(
     light: usize,
     options: AthertonWeilerGreenbergOptions,
     counters: &mut Counters,
-) -> Result<Vec<Vec<Lit>>> {
+) -> Result<Vec<Faces>> {
     let l = scene.lights.get(light).ok_or_else(|| {
         Error::out_of_range(
             "light",
@@ -1325,10 +1330,10 @@ fn lit_fragments(
             .collect::<Result<_>>()?;
         done.extend(views.into_iter().map(|(lit, stats)| (s, lit, stats)));
     }
-    let mut samples: Vec<Vec<Lit>> = (0..l.sample_count()).map(|_| Vec::new()).collect();
+    let mut samples: Vec<Faces> = (0..l.sample_count()).map(|_| Vec::new()).collect();
     let mut stats = Pass1::new(options);
     for (s, lit, st) in done {
-        samples[s].extend(lit);
+        samples[s].push(lit);
         stats.add(&st);
     }
     counters.add(crate::stats::Counter::LightSpaceFragments, stats.fragments);
@@ -1338,8 +1343,12 @@ fn lit_fragments(
     counters.add(crate::stats::Counter::LightViewTiles, stats.tiles);
     counters.add(crate::stats::Counter::LightViewBackgrounds, stats.backgrounds_found);
     counters.add(crate::stats::Counter::LightViewLone, stats.lone);
-    let detail: usize = samples.iter().map(Vec::len).sum();
-    let verts: usize = samples.iter().flatten().flat_map(|d| d.rings(scene)).map(<[DVec3]>::len).sum();
+    let detail: usize = samples.iter().flatten().map(Vec::len).sum();
+    let verts: usize = samples
+        .par_iter()
+        .flat_map(|faces| faces.par_iter().flat_map(|f| f.par_iter()))
+        .map(|d| d.rings(scene).map(<[DVec3]>::len).sum::<usize>())
+        .sum();
     counters.add(crate::stats::Counter::DetailPolygons, detail as u64);
     counters.add(crate::stats::Counter::DetailVertices, verts as u64);
     counters.add(crate::stats::Counter::Pass1Us, t.elapsed().as_micros() as u64);
@@ -1356,7 +1365,7 @@ impl ShadowDatabase {
         counters: &mut Counters,
     ) -> Result<ShadowDatabase> {
         let lit = lit_fragments(scene, light, options, counters)?;
-        let detail = |s: Vec<Lit>| s.into_par_iter().map(|f| f.into_detail(scene)).collect();
+        let detail = |s: Faces| s.into_par_iter().flatten().map(|f| f.into_detail(scene)).collect();
         Ok(ShadowDatabase { samples: lit.into_iter().map(detail).collect() })
     }
 
@@ -1397,7 +1406,7 @@ impl<'a> AthertonWeilerGreenberg<'a> {
         match &ctx.awg_database {
             Some(db) if db.len() == ctx.scene.lights.len() => {
                 for polys in db.iter().flat_map(|d| &d.samples) {
-                    let (wholes, screen) = through_camera(ctx, polys);
+                    let (wholes, screen) = through_camera(ctx, std::slice::from_ref(polys));
                     detail.push(overlay(ctx, &wholes, screen, counters));
                 }
             }
@@ -1407,7 +1416,7 @@ impl<'a> AthertonWeilerGreenberg<'a> {
             None => {
                 // The lights are independent: built side by side, one light's last cube face
                 // overlaps the next light's work. Counters are merged in light order.
-                let built: Vec<(Vec<Vec<Lit>>, Counters)> = (0..ctx.scene.lights.len())
+                let built: Vec<(Vec<Faces>, Counters)> = (0..ctx.scene.lights.len())
                     .into_par_iter()
                     .with_max_len(1)
                     .map(|l| {
@@ -1417,11 +1426,11 @@ impl<'a> AthertonWeilerGreenberg<'a> {
                     .collect::<Result<_>>()?;
                 for (samples, c) in built {
                     counters.merge(&c);
-                    for polys in samples {
-                        let (wholes, screen) = through_camera(ctx, &polys);
+                    for faces in samples {
+                        let (wholes, screen) = through_camera(ctx, &faces);
                         // Fragments built for this frame alone go once they are through the
                         // camera, before the overlay is made.
-                        crate::pieces::let_go(polys);
+                        faces.into_iter().for_each(crate::pieces::let_go);
                         detail.push(overlay(ctx, &wholes, screen, counters));
                     }
                 }
@@ -1434,18 +1443,18 @@ impl<'a> AthertonWeilerGreenberg<'a> {
 /// Fragments on screen: each one's source and its outlines.
 type OnScreen = Vec<(u32, Vec<Vec<DVec2>>)>;
 
-/// One sample's lit fragments through the camera, in parallel: the sources of those seen that
-/// are whole polygons, and the others' outlines on screen with their sources. A fragment that
-/// is its whole source polygon (ours) covers every run on it: it needs no edges (but is drawn
-/// with them for `--debug`).
-fn through_camera<F: Fragment>(ctx: &ShadowContext, polys: &[F]) -> (Vec<u32>, OnScreen) {
+/// One sample's lit fragments (the lists of `parts`, one after another) through the camera,
+/// in parallel: the sources of those seen that are whole polygons, and the others' outlines
+/// on screen with their sources. A fragment that is its whole source polygon (ours) covers
+/// every run on it: it needs no edges (but is drawn with them for `--debug`).
+fn through_camera<F: Fragment>(ctx: &ShadowContext, parts: &[Vec<F>]) -> (Vec<u32>, OnScreen) {
     let scene = ctx.scene;
-    let whole: Vec<bool> = polys.par_iter().map(|d| !ctx.keep_outlines && d.whole(scene)).collect();
+    let whole: Vec<Vec<bool>> =
+        parts.iter().map(|p| p.par_iter().map(|d| !ctx.keep_outlines && d.whole(scene)).collect()).collect();
+    let all = || parts.par_iter().zip(&whole).flat_map(|(p, w)| p.par_iter().zip(w));
     let seen = |(d, &whole): &(&F, &bool), want: bool| whole == want && ctx.visible[d.source() as usize];
-    let wholes = polys.par_iter().zip(&whole).filter(|p| seen(p, true)).map(|(d, _)| d.source()).collect();
-    let screen = polys
-        .par_iter()
-        .zip(&whole)
+    let wholes = all().filter(|p| seen(p, true)).map(|(d, _)| d.source()).collect();
+    let screen = all()
         .filter(|p| seen(p, false))
         .map(|(d, _)| d)
         .map_init(
