@@ -248,10 +248,12 @@ pub(crate) fn grid_rectangle(
     (gx, gy): (usize, usize),
     (a, b): (DVec2, DVec2),
 ) -> (usize, usize, usize, usize) {
-    let cell =
-        |v: f64, lo: f64, size: f64, g: usize| (((v - lo) / size * g as f64).floor().max(0.0) as usize).min(g - 1);
-    let (c0, c1) = (cell(a.x, lo.x, size.x, gx), cell(b.x, lo.x, size.x, gx));
-    let (r0, r1) = (cell(a.y, lo.y, size.y, gy), cell(b.y, lo.y, size.y, gy));
+    // Cells per unit, found once: a multiplication for each coordinate (a coordinate's cell
+    // only has to grow with it, for boxes that meet to share a cell).
+    let per = DVec2::new(gx as f64, gy as f64) / size;
+    let cell = |v: f64, lo: f64, per: f64, g: usize| (((v - lo) * per).floor().max(0.0) as usize).min(g - 1);
+    let (c0, c1) = (cell(a.x, lo.x, per.x, gx), cell(b.x, lo.x, per.x, gx));
+    let (r0, r1) = (cell(a.y, lo.y, per.y, gy), cell(b.y, lo.y, per.y, gy));
     (c0, c1, r0, r1)
 }
 
