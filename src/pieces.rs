@@ -163,6 +163,7 @@ mod tests {
         assert_eq!(joined(&parts, |k, &x| 10 * k as u32 + x), [11, 12, 33, 34, 35]);
         assert!(joined::<u32, u32>(&[&[], &[]], |_, &x| x).is_empty());
     }
+
     #[test]
     fn sorted_by_high_half_is_sorted_and_keeps_equal_halves_in_order() {
         use rand::{Rng, SeedableRng};

@@ -58,8 +58,8 @@ pub struct ShadowDatabase {
 }
 
 /// One light sample's lit fragments as pass 1 makes them: a list for each of its light views
-/// (a point sample's cube faces), in order, never copied into one list (ours: on s3 the
-/// copy, 470,000 fragments, was a fresh list's pages written by one thread each frame).
+/// (a point sample's cube faces), in order, never copied into one list (ours: on s3 such a
+/// copy writes 470,000 fragments to a fresh list's pages, on one thread, every frame).
 type Faces = Vec<Vec<Lit>>;
 
 /// A lit fragment as pass 1 makes it (ours): a source polygon lit whole is its index alone,
