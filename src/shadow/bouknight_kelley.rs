@@ -564,7 +564,7 @@ impl Wedge {
     /// is a corner of the receiver's edge on that plane (which lies on the plane exactly: a
     /// neighbour across that edge is seen from the light beside the receiver too).
     fn misses(&self, verts: &[DVec3]) -> bool {
-        self.planes.iter().any(|&(n, p, q)| verts.iter().all(|&v| v == p || v == q || n.dot(v - p) > self.margin))
+        self.planes.iter().any(|&(n, p, q)| verts.iter().all(|&v| n.dot(v - p) > self.margin || v == p || v == q))
     }
 }
 
