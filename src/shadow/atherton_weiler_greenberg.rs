@@ -633,22 +633,20 @@ impl LightView {
     ) -> Option<(DepthPlane, bool)> {
         match *self {
             LightView::Face { light, axis, e1, e2 } => {
-                // The frustum |p·e1|, |p·e2| <= p·axis, and a tiny near plane at the light.
-                let planes: [&dyn Fn(DVec3) -> f64; 5] = [
-                    &|p| p.dot(axis) - p.dot(e1),
-                    &|p| p.dot(axis) + p.dot(e1),
-                    &|p| p.dot(axis) - p.dot(e2),
-                    &|p| p.dot(axis) + p.dot(e2),
-                    &|p| p.dot(axis) - near,
-                ];
+                // The frustum |p·e1|, |p·e2| <= p·axis, and a tiny near plane at the light:
+                // each side's value at `p` (positive inside), from `p` in the face's frame.
+                let sides = |p: DVec3| {
+                    let (x, y, z) = (p.dot(e1), p.dot(e2), p.dot(axis));
+                    [z - x, z + x, z - y, z + y, z - near]
+                };
+                let planes: [&dyn Fn(DVec3) -> f64; 5] =
+                    [&|p| sides(p)[0], &|p| sides(p)[1], &|p| sides(p)[2], &|p| sides(p)[3], &|p| sides(p)[4]];
                 // Most polygons lie wholly outside some side of a face's frustum: they are
                 // dropped before they are copied. Each corner is put in the face's frame
-                // once, and the sides read from it (the values `planes` give).
+                // once, and every side read from it.
                 let (mut outside, mut whole) = ([true; 5], true);
                 for &v in verts {
-                    let p = v - light;
-                    let (x, y, z) = (p.dot(e1), p.dot(e2), p.dot(axis));
-                    for (out, side) in outside.iter_mut().zip([z - x, z + x, z - y, z + y, z - near]) {
+                    for (out, side) in outside.iter_mut().zip(sides(v - light)) {
                         *out &= side < 0.0;
                         whole &= side >= 0.0;
                     }
@@ -1448,29 +1446,28 @@ type OnScreen = Vec<(u32, Vec<Vec<DVec2>>)>;
 /// on screen with their sources. A fragment that is its whole source polygon (ours) covers
 /// every run on it: it needs no edges (but is drawn with them for `--debug`).
 fn through_camera<F: Fragment>(ctx: &ShadowContext, parts: &[Vec<F>]) -> (Vec<u32>, OnScreen) {
+    use rayon::iter::Either;
     let scene = ctx.scene;
-    let whole: Vec<Vec<bool>> =
-        parts.iter().map(|p| p.par_iter().map(|d| !ctx.keep_outlines && d.whole(scene)).collect()).collect();
-    let all = || parts.par_iter().zip(&whole).flat_map(|(p, w)| p.par_iter().zip(w));
-    let seen = |(d, &whole): &(&F, &bool), want: bool| whole == want && ctx.visible[d.source() as usize];
-    let wholes = all().filter(|p| seen(p, true)).map(|(d, _)| d.source()).collect();
-    let screen = all()
-        .filter(|p| seen(p, false))
-        .map(|(d, _)| d)
+    parts
+        .par_iter()
+        .flat_map(|p| p.par_iter())
+        .filter(|d| ctx.visible[d.source() as usize])
         .map_init(
             || ([Vec::new(), Vec::new()], Vec::new()),
             |(scratch, ring), d| {
+                if !ctx.keep_outlines && d.whole(scene) {
+                    return Either::Left(d.source());
+                }
                 let mut rings = Vec::new();
                 for r in d.rings(scene) {
                     if ctx.view.clip_project(r, scratch, ring) {
                         rings.push(ring.clone());
                     }
                 }
-                (d.source(), rings)
+                Either::Right((d.source(), rings))
             },
         )
-        .collect();
-    (wholes, screen)
+        .partition_map(|e| e)
 }
 
 /// One sample's overlay of the fragments [`through_camera`] gave.
