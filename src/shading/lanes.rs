@@ -56,7 +56,7 @@ pub(super) struct LineLanes {
 }
 
 /// What a run's lanes are filled from: the f64 coefficients above, rounded to f32.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 pub(super) struct RunGeometry {
     /// The ray through the first pixel's centre and its change per pixel.
     pub ray: [f32; 3],

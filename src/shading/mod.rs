@@ -221,6 +221,9 @@ struct RunShading {
     light: Vec<Vec3>,
     /// Scratch: one value per polygon vertex (Gouraud mode).
     vertex_colors: Vec<Vec3>,
+    /// What the lanes take of the run, filled where it lies (ours: returned and copied,
+    /// its copy's store stalled on the stores that had just made it).
+    geometry: RunGeometry,
 }
 
 /// Where an edge `k -> k+1` of the polygon meets the scan plane, at parameter `t` on the edge
@@ -414,15 +417,12 @@ impl<'a> Shader<'a> {
         lit: impl Fn(usize) -> &'l [f32] + Copy,
     ) -> bool {
         self.scan_crossings(rs);
-        let geometry = if f64_only { None } else { self.lane_geometry(rs) };
-        let geometry = geometry.and_then(|mut g| {
-            let (l, r) = self.crossing_pair(rs)?;
+        let pair = if !f64_only && self.lane_geometry(rs) { self.crossing_pair(rs) } else { None };
+        let in_lanes = pair.is_some();
+        if let Some((l, r)) = pair {
             let (num, div) = self.s_between(rs, l, r);
-            g.s = [num, div].map(|v| v.map(|x| x as f32));
-            Some(g)
-        });
-        if let Some(g) = &geometry {
-            lanes.gouraud_run(g, rs.len as usize);
+            rs.geometry.s = [num, div].map(|v| v.map(|x| x as f32));
+            lanes.gouraud_run(&rs.geometry, rs.len as usize);
         } else {
             self.prepare_f64(rs, false);
         }
@@ -432,7 +432,7 @@ impl<'a> Shader<'a> {
             let k = t.row;
             rs.vertex_colors.clear();
             rs.vertex_colors.extend(verts.iter().zip(vn).map(|(&p, &n)| self.shade(rs.poly, t, p, n * rs.flip)));
-            if geometry.is_some() {
+            if in_lanes {
                 let at = |c: ScanCrossing| crossing_value(&rs.vertex_colors, c, |v| v.as_dvec3()).as_vec3();
                 lanes.add_gouraud(rs.x0 as usize, at(rs.crossings[0]), at(rs.crossings[1]), lit(k));
                 continue;
@@ -447,7 +447,7 @@ impl<'a> Shader<'a> {
         // flat).
         let (centroid, n) = (centroid(verts), self.scene.polygons[rs.poly].plane.n * rs.flip);
         self.add_lambert(rs, lanes, lit, |_, _| centroid, |_, _| n);
-        geometry.is_some()
+        in_lanes
     }
 
     /// Phong: normals interpolated and renormalised, lit per pixel: in lanes when the run
@@ -466,13 +466,13 @@ impl<'a> Shader<'a> {
         if !triangle {
             self.scan_crossings(rs);
         }
-        let geometry = if f64_only { None } else { self.lane_geometry(rs) };
-        if let Some(mut g) = geometry.filter(|_| self.lights_fit_lanes(rs)) {
+        if !f64_only && self.lane_geometry(rs) && self.lights_fit_lanes(rs) {
             let normal = if triangle { self.triangle_normals(rs, barycentric) } else { self.crossing_normals(rs) };
             if let Some(normal) = normal {
-                g.normal = normal.map(|n| n.as_vec3().to_array());
-                g.plane = (self.scene.polygons[rs.poly].plane.n * rs.flip).as_vec3().to_array();
-                lanes.phong_run(rs.x0 as usize, rs.len as usize, &g, self.scene.material_index(rs.poly) as u32);
+                rs.geometry.normal = normal.map(|n| n.as_vec3().to_array());
+                rs.geometry.plane = (self.scene.polygons[rs.poly].plane.n * rs.flip).as_vec3().to_array();
+                let material = self.scene.material_index(rs.poly) as u32;
+                lanes.phong_run(rs.x0 as usize, rs.len as usize, &rs.geometry, material);
                 return true;
             }
         }
@@ -553,9 +553,10 @@ impl<'a> Shader<'a> {
         rs.crossings.sort_unstable_by(|a, b| a.u.total_cmp(&b.u));
     }
 
-    /// Where the run's rays meet its polygon's plane, as the lanes take it, if its points fit
-    /// single precision ([`LANE_REACH`]); keeps the f64 values in `rs` for what follows.
-    fn lane_geometry(&self, rs: &mut RunShading) -> Option<RunGeometry> {
+    /// Where the run's rays meet its polygon's plane, as the lanes take it (`rs.geometry`),
+    /// if its points fit single precision ([`LANE_REACH`]); keeps the f64 values in `rs`
+    /// for what follows. Returns whether they fit.
+    fn lane_geometry(&self, rs: &mut RunShading) -> bool {
         let plane = &self.scene.polygons[rs.poly].plane;
         let step = rs.step;
         let ray = rs.ray_row + step * rs.x0 as f64;
@@ -564,18 +565,13 @@ impl<'a> Shader<'a> {
         let reach2 = |i: f64| ((ray + step * i) * (depth / (den[0] + i * den[1]))).length_squared();
         rs.reach = reach2(0.0).max(reach2((rs.len - 1) as f64)).sqrt();
         if rs.reach.is_nan() || rs.reach >= LANE_REACH {
-            return None;
+            return false;
         }
         (rs.ray, rs.depth, rs.den) = (ray, depth, den);
-        Some(RunGeometry {
-            ray: ray.as_vec3().to_array(),
-            step: step.as_vec3().to_array(),
-            depth: depth as f32,
-            den: den.map(|x| x as f32),
-            s: [[0.0; 2]; 2],
-            normal: [[0.0; 3]; 2],
-            plane: [0.0; 3],
-        })
+        let g = &mut rs.geometry;
+        (g.ray, g.step) = (ray.as_vec3().to_array(), step.as_vec3().to_array());
+        (g.depth, g.den) = (depth as f32, den.map(|x| x as f32));
+        true
     }
 
     /// The run's two crossings, left to right, if its line crosses the outline just twice.
