@@ -35,8 +35,8 @@ use crate::error::{Error, Result};
 pub use crate::geometry::Plane;
 use crate::geometry::{classify_face, newell_normal, FaceShape};
 use glam::{DMat3, DMat4, DVec3, Vec3};
+use rustc_hash::FxHashMap;
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
 use std::sync::Arc;
 
 /// The pinhole camera of section 3.
@@ -678,7 +678,8 @@ impl Scene {
             // Averaged normals for faces without `vn`: area-weighted face normals summed over
             // every face that shares the vertex's position (meshes often repeat a position
             // along a texture seam; welding keeps the seam from showing).
-            let mut weld: HashMap<[u64; 3], usize> = HashMap::new();
+            let mut weld: FxHashMap<[u64; 3], usize> = FxHashMap::default();
+            weld.reserve(world.len());
             let rep: Vec<usize> = world
                 .iter()
                 .enumerate()

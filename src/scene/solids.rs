@@ -25,6 +25,7 @@
 
 use super::LightSample;
 use glam::DVec3;
+use rayon::slice::ParallelSliceMut;
 
 /// No solid: the polygon is on an open or non-manifold part of its mesh.
 pub(crate) const NO_SOLID: u32 = u32::MAX;
@@ -151,7 +152,8 @@ fn pair_edges(corners: &Corners, sets: &mut DisjointSets, open: &mut [bool], acr
             edges.push((a.min(b), a.max(b), a > b, p as u32, start + k as u32));
         }
     }
-    edges.sort_unstable();
+    // Every edge is distinct (its corner is its own), so any sort gives this order.
+    edges.par_sort_unstable();
     for group in edges.chunk_by(|e, f| (e.0, e.1) == (f.0, f.1)) {
         if let [e, f] = group {
             if e.2 != f.2 {
