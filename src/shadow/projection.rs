@@ -99,6 +99,19 @@ impl Target {
     pub fn misses(&self, verts: &[DVec3]) -> bool {
         self.pyramid.iter().any(|&(origin, m)| verts.iter().all(|&x| m.dot(x - origin) < 0.0))
     }
+
+    /// Whether the box `(lo, hi)` lies wholly outside one face of the pyramid, by a margin
+    /// (a relative 1e-9) that rounding cannot cross: then [`Target::misses`] holds for every
+    /// polygon whose corners lie in the box (ours: a whole piece of polygons is passed over).
+    pub fn misses_box(&self, (lo, hi): (DVec3, DVec3)) -> bool {
+        let corners = [0, 1, 2, 3, 4, 5, 6, 7]
+            .map(|k| DVec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo));
+        self.pyramid.iter().any(|&(origin, m)| {
+            let reach = corners.iter().map(|&c| (c - origin).length()).fold(0.0, f64::max) + origin.length();
+            let margin = 1e-9 * m.length() * reach;
+            margin.is_finite() && corners.iter().all(|&c| m.dot(c - origin) < -margin)
+        })
+    }
 }
 
 /// Projects polygons from a light sample onto a [`Target`], keeping the scratch space
@@ -168,4 +181,52 @@ pub fn bounding_rectangle(verts: &[DVec3], plane: &Plane) -> [DVec3; 4] {
     let (lo, hi) = (lo - grow, hi + grow);
     let o = -plane.d * plane.n;
     [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].map(|c| o + c.x * u + c.y * v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// A box the pyramid misses holds no polygon it meets: every polygon inside it is
+    /// missed too, and most boxes well away from the pyramid are found to miss it.
+    #[test]
+    fn a_box_missed_holds_only_polygons_missed() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let plane = Plane::new(DVec3::Z, DVec3::ZERO);
+        let rect = [
+            DVec3::new(-1.0, -1.0, 0.0),
+            DVec3::new(1.0, -1.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(-1.0, 1.0, 0.0),
+        ];
+        let (mut missed, mut tried) = (0, 0);
+        for _ in 0..2000 {
+            let light = DVec3::new(rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0), rng.gen_range(2.0..8.0));
+            let target = Target::new(plane, rect, LightSample::Point(light));
+            let centre = DVec3::new(rng.gen_range(-6.0..6.0), rng.gen_range(-6.0..6.0), rng.gen_range(-1.0..9.0));
+            let half = DVec3::new(rng.gen_range(0.0..1.5), rng.gen_range(0.0..1.5), rng.gen_range(0.0..1.5));
+            let (lo, hi) = (centre - half, centre + half);
+            tried += 1;
+            if !target.misses_box((lo, hi)) {
+                continue;
+            }
+            missed += 1;
+            for _ in 0..20 {
+                let point = |rng: &mut rand_chacha::ChaCha8Rng| {
+                    // Corners and faces of the box too, where rounding is closest.
+                    let t = DVec3::new(rng.gen_range(0.0..=1.0), rng.gen_range(0.0..=1.0), rng.gen_range(0.0..=1.0));
+                    let t = if rng.gen_bool(0.3) { t.round() } else { t };
+                    (lo + (hi - lo) * t).clamp(lo, hi)
+                };
+                let verts = [point(&mut rng), point(&mut rng), point(&mut rng)];
+                assert!(target.misses(&verts), "{verts:?} in a box missed by the pyramid from {light}");
+            }
+        }
+        assert!(missed * 4 > tried, "only {missed} of {tried} boxes missed");
+        // A box around the light meets every face.
+        let light = DVec3::new(0.0, 0.0, 4.0);
+        let target = Target::new(plane, rect, LightSample::Point(light));
+        assert!(!target.misses_box((light - DVec3::ONE, light + DVec3::ONE)));
+    }
 }

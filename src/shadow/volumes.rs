@@ -187,10 +187,13 @@ fn shadow_polygons(
     // the times it winds for the edges' pass.
     let front_wound: Vec<AtomicI8> =
         (0..if front_outline { ctx.scene.polygons.len() } else { 0 }).map(|_| AtomicI8::new(0)).collect();
-    let caps = adjacency.merged.par_chunks(PIECE).map_init(
+    let caps = adjacency.merged.par_chunks(PIECE).zip(&adjacency.merged_boxes).map_init(
         || (Scratch::default(), Projector::default()),
-        |(scratch, proj), polys| {
+        |(scratch, proj), (polys, &bounds)| {
             let mut piece = Piece::default();
+            if !far_outline && b.caps_miss(bounds) {
+                return piece;
+            }
             for &p in polys.iter().filter(|&&p| casts(p as usize)) {
                 let verts = ctx.scene.verts(p as usize);
                 if !far_outline {
@@ -627,6 +630,12 @@ impl<'c> Builder<'c> {
         }
     }
 
+    /// Whether [`Builder::caps`] makes no cap for any polygon whose corners lie in the box
+    /// `bounds`: z-pass's near caps, whose pyramid misses it.
+    fn caps_miss(&self, bounds: (DVec3, DVec3)) -> bool {
+        self.counting == Counting::ZPass && self.near.misses_box(bounds)
+    }
+
     /// Z-fail's front cap of the volume of `verts` (on scene polygon `poly`): the polygon
     /// itself.
     fn front_cap(&self, verts: &[DVec3], poly: usize, owner: Option<u32>) -> ShadowPolygon {
@@ -714,6 +723,9 @@ pub struct Adjacency {
     sharing: Vec<Sharing>,
     /// The merged polygons (their caps).
     merged: Vec<u32>,
+    /// The bounds of the corners of each [`PIECE`] of `merged`, in order (ours: a near cap's
+    /// test passes over a piece whose box the near rectangle's pyramid misses).
+    merged_boxes: Vec<(DVec3, DVec3)>,
     /// The volumes kept apart.
     apart: Vec<Apart>,
 }
@@ -833,6 +845,14 @@ impl Adjacency {
             }
         }
         adjacency.group(scene, keyed);
+        adjacency.merged_boxes = adjacency
+            .merged
+            .par_chunks(PIECE)
+            .map(|polys| {
+                let corners = polys.iter().flat_map(|&p| scene.verts(p as usize));
+                corners.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)))
+            })
+            .collect();
         adjacency
     }
 
