@@ -221,8 +221,8 @@ struct RunShading {
     light: Vec<Vec3>,
     /// Scratch: one value per polygon vertex (Gouraud mode).
     vertex_colors: Vec<Vec3>,
-    /// What the lanes take of the run, filled where it lies (ours: returned and copied,
-    /// its copy's store stalled on the stores that had just made it).
+    /// What the lanes take of the run, written here in place (ours: a copy of a struct just
+    /// made and returned waits on the stores that made it).
     geometry: RunGeometry,
 }
 
