@@ -912,7 +912,9 @@ fn lit_in_view(
             Ok((lit.into_iter().map(unmap).collect(), cover, st))
         })
         .collect::<std::result::Result<_, ClipError>>()?;
-    let mut detail = Vec::new();
+    // Room for every fragment at once: the lone polygons, half a million on s3, come last.
+    let fragments = done.iter().map(|(lit, _, _)| lit.len()).sum::<usize>() + lone.behind.len() + lone.lone.len();
+    let mut detail = Vec::with_capacity(fragments);
     let mut cover = Vec::new();
     for (lit, c, st) in done {
         detail.extend(lit);
@@ -921,7 +923,7 @@ fn lit_in_view(
     }
     // The wide backgrounds, lit where no visible piece or lone sheet covers them.
     let over: Vec<&Piece> = cover.iter().chain(&lone.outlines).collect();
-    let behind: Vec<Piece> = lone.behind.into_par_iter().filter_map(|b| holed(b, over.iter().copied())).collect();
+    let behind: Vec<Piece> = lone.behind.into_par_iter().filter_map(|b| holed(b, &over)).collect();
     detail.par_extend(behind.into_par_iter().map(unmap));
     detail.par_extend(lone.lone.into_par_iter().map(Lit::Whole));
     Ok(detail)
@@ -948,7 +950,7 @@ struct LoneSplit {
 fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
     let n = m.polys.len();
     let behind =
-        if backgrounds && m.polys.iter().all(|p| p.casts) { wide_backgrounds(scene, m) } else { vec![false; n] };
+        if backgrounds && m.polys.par_iter().all(|p| p.casts) { wide_backgrounds(scene, m) } else { vec![false; n] };
     let kept: Vec<usize> = (0..n).into_par_iter().filter(|&i| !behind[i]).collect();
     // The items across each whole caster's edges, by their places among the kept (a whole
     // polygon is mapped once a view: a source's place is read from `place`): worked out in
@@ -1063,11 +1065,20 @@ fn wide_backgrounds(scene: &Scene, m: &Mapped) -> Vec<bool> {
 
 /// `b` with the pieces of `over` that meet its box cut out as holes (by the even-odd rule):
 /// they must lie inside it and not overlap one another.
-fn holed<'a>(b: Piece, over: impl Iterator<Item = &'a Piece>) -> Option<Piece> {
+fn holed<'a>(b: Piece, over: &[&'a Piece]) -> Option<Piece> {
     let mut rings = b.region.rings.clone();
-    rings.extend(over.filter(|s| s.overlaps(&b)).flat_map(|s| s.region.rings.iter().cloned()));
+    let holes = |s: &&'a Piece| s.overlaps(&b).then(|| s.region.rings.iter().cloned()).into_iter().flatten();
+    // In order, and by all threads where there are many (ours: a floor under a crowd takes
+    // tens of thousands of holes).
+    match over.len() < PARALLEL_HOLES {
+        true => rings.extend(over.iter().flat_map(holes)),
+        false => rings.par_extend(over.par_iter().flat_map_iter(holes)),
+    }
     Piece::new(b.source, Region { rings }, b.near)
 }
+
+/// Fewer pieces than this are read for holes by one thread.
+const PARALLEL_HOLES: usize = 1024;
 
 /// Deepest a list's pieces may lie over one another (by area, on average) for convex
 /// pieces to be split by edges.
@@ -1289,7 +1300,7 @@ fn behind_all(b: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Resul
             return outside_all(b, &over, stats);
         }
     }
-    Ok(holed(b, holes.into_iter()).into_iter().collect())
+    Ok(holed(b, &holes).into_iter().collect())
 }
 
 /// Pass 1 and the merge for light `light` of `scene` ([`ShadowDatabase::build`]): every
