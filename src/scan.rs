@@ -1017,8 +1017,8 @@ impl OpenSet {
 mod tests {
     use super::*;
 
-    /// The keys the walk sorts entering edges by order x as `f64::total_cmp` does: signed
-    /// zeros, infinities, subnormals and random values of both signs, every pair.
+    /// The bucketed sort of entering edges' keys gives `sort_unstable`'s order: spread,
+    /// clustered and nearly equal x, with infinities, NaN and signed zeros among them.
     #[test]
     fn sort_by_x_sorts_as_sort_unstable() {
         use rand::{Rng, SeedableRng};
@@ -1045,6 +1045,8 @@ mod tests {
         }
     }
 
+    /// The keys the walk sorts entering edges by order x as `f64::total_cmp` does: signed
+    /// zeros, infinities, subnormals and random values of both signs, every pair.
     #[test]
     fn ordered_bits_order_as_total_cmp() {
         use rand::{Rng, SeedableRng};

@@ -191,7 +191,7 @@ fn shadow_polygons(
         || (Scratch::default(), Projector::default()),
         |(scratch, proj), (polys, &bounds)| {
             let mut piece = Piece::default();
-            if !far_outline && b.caps_miss(bounds) {
+            if b.caps_miss(bounds) {
                 return piece;
             }
             for &p in polys.iter().filter(|&&p| casts(p as usize)) {
