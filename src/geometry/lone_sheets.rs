@@ -62,14 +62,16 @@ pub(crate) fn find(items: &[Item]) -> Lone {
         by_root.entry(root[i]).or_default().push(i as u32);
     }
     let members: Vec<(u32, Vec<u32>)> = by_root.into_iter().collect();
-    let valid: FxHashMap<u32, bool> = members.par_iter().map(|(r, m)| (*r, clears_itself(items, &root, m))).collect();
+    // `valid[r]`: whether the sheet rooted at item `r` clears itself.
+    let mut valid = vec![false; n];
+    for (r, ok) in members.par_iter().map(|(r, m)| (*r, clears_itself(items, &root, m))).collect::<Vec<_>>() {
+        valid[r as usize] = ok;
+    }
+    let in_valid = |i: usize| root[i] != NO_ITEM && valid[root[i] as usize];
     // The grid: each cell holds the one owner whose boxes meet it, or CONFLICT.
-    let owner = |i: usize| if root[i] != NO_ITEM && valid[&root[i]] { root[i] } else { (n + i) as u32 };
+    let owner = |i: usize| if in_valid(i) { root[i] } else { (n + i) as u32 };
     let Some(grid) = Grid::new(items, owner) else { return lone };
-    lone.lone = (0..n)
-        .into_par_iter()
-        .map(|i| root[i] != NO_ITEM && valid[&root[i]] && grid.only(items[i].bounds, root[i]))
-        .collect();
+    lone.lone = (0..n).into_par_iter().map(|i| in_valid(i) && grid.only(items[i].bounds, root[i])).collect();
     lone.outlines = members
         .par_iter()
         .filter_map(|(_, m)| {
@@ -239,7 +241,8 @@ fn chain_all(edges: &[(DVec2, DVec2)]) -> Vec<Vec<DVec2>> {
 
 /// A uniform grid over the items' boxes whose cells hold one owner each.
 struct Grid {
-    cells: Vec<u32>,
+    /// Each cell's mark, as all threads left it.
+    cells: Vec<AtomicU32>,
     lo: DVec2,
     size: DVec2,
     /// Columns and rows.
@@ -289,13 +292,13 @@ impl Grid {
                 let _ = cells[c * g.1 + r].fetch_update(Ordering::Relaxed, Ordering::Relaxed, merge);
             }
         });
-        let cells = cells.into_par_iter().map(AtomicU32::into_inner).collect();
         Some(Grid { cells, lo, size, g })
     }
 
     /// Whether every cell `bounds` meets is held by `owner` alone.
     fn only(&self, bounds: (DVec2, DVec2), owner: u32) -> bool {
-        grid_cells(self.lo, self.size, self.g, bounds).all(|(c, r)| self.cells[c * self.g.1 + r] == owner)
+        let mark = |c: usize, r: usize| self.cells[c * self.g.1 + r].load(Ordering::Relaxed);
+        grid_cells(self.lo, self.size, self.g, bounds).all(|(c, r)| mark(c, r) == owner)
     }
 }
 

@@ -1097,7 +1097,7 @@ fn stacked(casters: &[Piece], others: &[Piece]) -> bool {
 }
 
 /// Most casters a region of a light view keeps before it is cut in four.
-const TILE_PIECES: usize = 128;
+const TILE_PIECES: usize = 1024;
 
 /// Regions of a light view (ours, not the paper's), found by cutting the view in four, at the
 /// median of the casters' centres, until each region holds at most [`TILE_PIECES`]
@@ -1226,8 +1226,9 @@ fn lit_pieces(
             kept.push(c);
         }
     }
-    let casters = kept;
-    let seen = visible(casters.clone(), 0, stats)?;
+    // The casters are kept for the fans' own sorts, where there are fans.
+    let casters = if kept.iter().any(split) { kept.clone() } else { Vec::new() };
+    let seen = visible(kept, 0, stats)?;
     let mut pieces: Vec<Piece> = seen.iter().filter(|p| !split(p)).cloned().collect();
     for p in casters.iter().filter(|p| split(p)) {
         let list =

@@ -157,7 +157,7 @@ pub struct AthertonWeilerGreenbergOptions {
     /// polygons turned to the light do not. `false` puts every polygon in the view, as the
     /// paper does.
     pub solid_cull: bool,
-    /// Cut each light view into regions of at most 128 casters and sort them apart (default
+    /// Cut each light view into regions of at most 1,024 casters and sort them apart (default
     /// true; ours): what hides what inside a region depends only on what lies in it. `false`
     /// sorts the whole view at once, as the paper does.
     pub tiling: bool,

@@ -172,7 +172,7 @@ struct AwgFlags {
     #[arg(long)]
     no_lone_sheets: bool,
     /// Atherton-Weiler-Greenberg: sort each light view whole, as the paper does, instead of
-    /// cutting it into regions of at most 128 casters sorted apart.
+    /// cutting it into regions of at most 1,024 casters sorted apart.
     #[arg(long)]
     no_tiling: bool,
     /// Atherton-Weiler-Greenberg: map every polygon into all six views of the cube around a
