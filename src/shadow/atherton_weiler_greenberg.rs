@@ -633,20 +633,28 @@ impl LightView {
     ) -> Option<(DepthPlane, bool)> {
         match *self {
             LightView::Face { light, axis, e1, e2 } => {
-                // The frustum |p·e1|, |p·e2| <= p·axis, and a tiny near plane at the light:
-                // each side's value at `p` (positive inside), from `p` in the face's frame.
-                let sides = |p: DVec3| {
-                    let (x, y, z) = (p.dot(e1), p.dot(e2), p.dot(axis));
-                    [z - x, z + x, z - y, z + y, z - near]
-                };
-                let planes: [&dyn Fn(DVec3) -> f64; 5] =
-                    [&|p| sides(p)[0], &|p| sides(p)[1], &|p| sides(p)[2], &|p| sides(p)[3], &|p| sides(p)[4]];
+                // The frustum |x|, |y| <= z, and a tiny near plane at the light, with
+                // (x, y, z) = (p·e1, p·e2, p·axis) the face's frame of `p`, a point relative
+                // to the light: each side's value (positive inside).
+                let frame = |p: DVec3| DVec3::new(p.dot(e1), p.dot(e2), p.dot(axis));
+                let sides = |f: DVec3| [f.z - f.x, f.z + f.x, f.z - f.y, f.z + f.y, f.z - near];
+                let planes: [&dyn Fn(DVec3) -> f64; 5] = [
+                    &|p| sides(frame(p))[0],
+                    &|p| sides(frame(p))[1],
+                    &|p| sides(frame(p))[2],
+                    &|p| sides(frame(p))[3],
+                    &|p| sides(frame(p))[4],
+                ];
                 // Most polygons lie wholly outside some side of a face's frustum: they are
                 // dropped before they are copied. Each corner is put in the face's frame
-                // once, and every side read from it.
+                // once, and every side read from it; a polygon wholly inside is mapped from
+                // those frames (ours).
+                let [a, b] = scratch;
+                b.clear();
+                b.extend(verts.iter().map(|&v| frame(v - light)));
                 let (mut outside, mut whole) = ([true; 5], true);
-                for &v in verts {
-                    for (out, side) in outside.iter_mut().zip(sides(v - light)) {
+                for &f in b.iter() {
+                    for (out, side) in outside.iter_mut().zip(sides(f)) {
                         *out &= side < 0.0;
                         whole &= side >= 0.0;
                     }
@@ -654,15 +662,16 @@ impl LightView {
                 if outside.contains(&true) {
                     return None;
                 }
-                let [a, b] = scratch;
-                a.clear();
-                a.extend(verts.iter().map(|&v| v - light));
                 if !whole {
+                    a.clear();
+                    a.extend(verts.iter().map(|&v| v - light));
                     for f in planes {
                         clip_in_place(a, b, f);
                     }
+                    b.clear();
+                    b.extend(a.iter().map(|&p| frame(p)));
                 }
-                if a.len() < 3 {
+                if b.len() < 3 {
                     return None;
                 }
                 // Nearness = 1 / (depth along the axis) of the plane's point seen at (u, v):
@@ -673,7 +682,7 @@ impl LightView {
                 }
                 let n = plane.n;
                 let near_fn = DepthPlane { a: -n.dot(e1) / k, b: -n.dot(e2) / k, c: -n.dot(axis) / k };
-                out.extend(a.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2)) / p.dot(axis)));
+                out.extend(b.iter().map(|f| DVec2::new(f.x, f.y) / f.z));
                 Some((near_fn, whole))
             }
             LightView::Parallel { d, e1, e2 } => {
