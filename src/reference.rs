@@ -282,7 +282,7 @@ fn view_among(
     }
     out.fraction = region.area().abs().min(1.0);
     if keep {
-        out.visible = region.rings;
+        out.visible = region.rings.into_vec();
     }
     Some(out)
 }

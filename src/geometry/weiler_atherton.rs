@@ -43,8 +43,10 @@ pub type Ring = Vec<DVec2>;
 /// A planar region: rings by the even-odd rule.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Region {
-    /// The outlines (outer boundaries and holes, any orientation).
-    pub rings: Vec<Ring>,
+    /// The outlines (outer boundaries and holes, any orientation). One ring is held in place
+    /// (ours): most regions of a light view's sort are one convex piece, and a list of their
+    /// own would cost each piece one allocation more.
+    pub rings: smallvec::SmallVec<[Ring; 1]>,
 }
 
 /// The two parts of a clipped subject.
@@ -79,7 +81,7 @@ pub enum ClipError {
 impl Region {
     /// A region of one ring.
     pub fn from_ring(ring: Ring) -> Region {
-        Region { rings: vec![ring] }
+        Region { rings: smallvec::smallvec![ring] }
     }
 
     /// Whether it has no rings.
@@ -304,7 +306,7 @@ fn rings_that_meet(
     let (near, far): (Vec<Ring>, Vec<Ring>) =
         subject.rings.iter().filter(|r| solid(r)).cloned().partition(|r| meets(r, cb));
     let c_near: Vec<Ring> = clip.rings.iter().filter(|r| solid(r) && meets(r, sb)).cloned().collect();
-    (oriented(&Region { rings: near }), oriented(&Region { rings: c_near }), far)
+    (oriented(&Region { rings: near.into() }), oriented(&Region { rings: c_near.into() }), far)
 }
 
 /// Whether the insides of `a` and `b` cannot overlap, found without clipping or allocating:
@@ -742,7 +744,7 @@ mod tests {
             ),
         ];
         for (k, (s, c)) in cases.into_iter().enumerate() {
-            let (s, c) = (Region { rings: s }, Region { rings: c });
+            let (s, c) = (Region { rings: s.into() }, Region { rings: c.into() });
             let got = clip(&s, &c).unwrap_or_else(|e| panic!("case {k}: {e}"));
             let whole = s.area();
             let sum = got.inside.area() + got.outside.area();
@@ -768,7 +770,7 @@ mod tests {
             v(0.40402938209023775, 0.4734245454192516),
             v(0.39913879828335785, 0.4674982529295048),
         ];
-        let subject = Region { rings: vec![big.clone(), small.clone()] };
+        let subject = Region { rings: smallvec::smallvec![big.clone(), small.clone()] };
         let clip_region = Region::from_ring(vec![
             v(0.2457673609851577, 0.3967091908593825),
             v(0.3308618722208037, 0.3148395242798902),
@@ -788,7 +790,7 @@ mod tests {
     fn outer_ring_with_a_hole_touching_the_clip() {
         let v = DVec2::new;
         let subject = Region {
-            rings: vec![
+            rings: smallvec::smallvec![
                 vec![v(-1.0, -1.0), v(-1.0, 1.0), v(1.0, 1.0), v(1.0, -1.0)],
                 vec![
                     v(-0.07938539034526589, -0.5118857837228907),

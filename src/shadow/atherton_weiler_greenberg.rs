@@ -994,7 +994,7 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
         .into_iter()
         .filter_map(|(one, rings)| {
             let p = &m.polys[kept[one as usize]];
-            Piece::new(p.source, Region { rings }, p.near)
+            Piece::new(p.source, Region { rings: rings.into() }, p.near)
         })
         .collect();
     // What goes on to the sort: the kept polygons (all but the wide backgrounds) not lone.
@@ -1075,7 +1075,7 @@ fn wide_backgrounds(scene: &Scene, m: &Mapped) -> Vec<bool> {
 /// `b` with the pieces of `over` that meet its box cut out as holes (by the even-odd rule):
 /// they must lie inside it and not overlap one another.
 fn holed<'a>(b: Piece, over: &[&'a Piece]) -> Option<Piece> {
-    let mut rings = b.region.rings.clone();
+    let mut rings = b.region.rings.to_vec();
     let holes = |s: &&'a Piece| s.overlaps(&b).then(|| s.region.rings.iter().cloned()).into_iter().flatten();
     // In order, and by all threads where there are many (ours: a floor under a crowd takes
     // tens of thousands of holes).
@@ -1083,7 +1083,7 @@ fn holed<'a>(b: Piece, over: &[&'a Piece]) -> Option<Piece> {
         true => rings.extend(over.iter().flat_map(holes)),
         false => rings.par_extend(over.par_iter().flat_map_iter(holes)),
     }
-    Piece::new(b.source, Region { rings }, b.near)
+    Piece::new(b.source, Region { rings: rings.into() }, b.near)
 }
 
 /// Fewer pieces than this are read for holes by one thread.
@@ -1202,7 +1202,7 @@ fn cut_to(region: &Region, (lo, hi): (DVec2, DVec2)) -> Region {
             rings.push(b.clone());
         }
     }
-    Region { rings }
+    Region { rings: rings.into() }
 }
 
 /// Step 1(b) on one list of pieces: the lit part of every caster and of every other polygon.
