@@ -146,6 +146,25 @@ pub fn holds(ring: &[DVec2], mut points: impl Iterator<Item = DVec2>) -> bool {
     t != 0.0 && points.all(|p| (0..n).all(|i| (ring[(i + 1) % n] - ring[i]).perp_dot(p - ring[i]) * t >= 0.0))
 }
 
+/// Whether convex `ring` holds the whole box `(lo, hi)` with room to spare, so that
+/// [`holds`] is true for any points in the box (ours): every corner lies inside the line
+/// of every edge `e` from `a` by more than `1e-9 |e|₁ r`, where `r` is the farthest any
+/// corner is from `a` along an axis. [`holds`]' product for a point `p` of the box errs by
+/// some `1e-15 |e|₁ r` at most, and its exact value is at least the least of the corners'
+/// (it is affine in `p`).
+pub fn holds_box(ring: &[DVec2], (lo, hi): (DVec2, DVec2)) -> bool {
+    let t = turn(ring);
+    let n = ring.len();
+    let corners = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+    t != 0.0
+        && (0..n).all(|i| {
+            let (a, e) = (ring[i], ring[(i + 1) % n] - ring[i]);
+            let reach = corners.iter().map(|&c| (c - a).abs().max_element()).fold(0.0, f64::max);
+            let margin = 1e-9 * (e.x.abs() + e.y.abs()) * reach;
+            corners.iter().all(|&c| e.perp_dot(c - a) * t > margin)
+        })
+}
+
 /// +1 for a ring wound counter-clockwise, −1 clockwise, 0 without area (where `f64::signum`
 /// would give 1).
 fn turn(ring: &[DVec2]) -> f64 {
@@ -238,6 +257,50 @@ mod tests {
             assert!(!holds(ring, [v(1.0, 1.0), v(2.5, 1.0)].into_iter()));
         }
         assert!(!holds(&[v(0.0, 0.0), v(1.0, 0.0), v(2.0, 0.0)], [v(1.0, 0.0)].into_iter()));
+    }
+
+    /// A box that a convex ring is found to hold with room to spare holds only points the
+    /// ring holds: 3,000 random rings (either way round) and boxes, some nearly touching an
+    /// edge, 40 points in each held box (its corners and edges among them). At least a
+    /// tenth of the boxes are found held, and a box over the outline never is.
+    #[test]
+    fn a_box_held_holds_only_points_held() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut found = 0;
+        for case in 0..3000 {
+            let k = rng.gen_range(3..8);
+            let c = v(rng.gen_range(-1e3..1e3), rng.gen_range(-1e3..1e3));
+            let r = 10f64.powi(rng.gen_range(-3..4));
+            let mut ring: Vec<DVec2> = (0..k)
+                .map(|j| {
+                    let a = std::f64::consts::TAU * (j as f64 + rng.gen_range(0.0..0.9)) / k as f64;
+                    c + v(a.cos(), a.sin()) * r
+                })
+                .collect();
+            if case % 2 == 1 {
+                ring.reverse();
+            }
+            // A box around a point near the centre, or one reaching the outline's corner.
+            let m = c + v(rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)) * r;
+            let half = r * 10f64.powi(rng.gen_range(-9..0));
+            let bx = if case % 5 == 0 { (m.min(ring[0]), m.max(ring[0])) } else { (m - half, m + half) };
+            if !holds_box(&ring, bx) {
+                continue;
+            }
+            found += 1;
+            assert!(case % 5 != 0, "a box reaching a corner of the outline is held");
+            let (lo, hi) = bx;
+            let mut points = vec![lo, hi, v(lo.x, hi.y), v(hi.x, lo.y)];
+            points.extend((0..36).map(|_| {
+                let (s, u) = (rng.gen_range(0.0..=1.0), rng.gen_range(0.0..=1.0));
+                v(lo.x + (hi.x - lo.x) * s, lo.y + (hi.y - lo.y) * u)
+            }));
+            for p in points {
+                assert!(holds(&ring, std::iter::once(p)), "case {case}: {p} in {bx:?}");
+            }
+        }
+        assert!(found > 300, "{found} boxes held");
     }
 
     #[test]

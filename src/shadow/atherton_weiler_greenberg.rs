@@ -1061,16 +1061,25 @@ fn wide_backgrounds(scene: &Scene, m: &Mapped) -> Vec<bool> {
     for &w in wide.iter().take(WIDE_TRIED) {
         let b = &m.polys[w];
         let ring = m.ring(b);
-        behind[w] = m.polys.par_iter().enumerate().all(|(i, q)| {
-            let points = || m.ring(q).iter().copied();
-            i == w
-                || !boxes_meet(q.bounds, b.bounds)
-                || (convex_split::holds(ring, points())
-                    && matches!(relation_at(points(), &q.near, &b.near), Relation::Front))
+        behind[w] = m.polys.par_chunks(WIDE_PIECE).enumerate().all(|(k, chunk)| {
+            // Where the candidate holds a piece's whole box, its polygons' corners need no
+            // test of their own (ours: on s3 the floor holds every sphere).
+            let union = chunk.iter().map(|q| q.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
+            let held = union.is_some_and(|u| convex_split::holds_box(ring, u));
+            chunk.iter().enumerate().all(|(j, q)| {
+                let points = || m.ring(q).iter().copied();
+                k * WIDE_PIECE + j == w
+                    || !boxes_meet(q.bounds, b.bounds)
+                    || ((held || convex_split::holds(ring, points()))
+                        && matches!(relation_at(points(), &q.near, &b.near), Relation::Front))
+            })
         });
     }
     behind
 }
+
+/// Polygons [`wide_backgrounds`] tests as one piece.
+const WIDE_PIECE: usize = 1024;
 
 /// `b` with the pieces of `over` that meet its box cut out as holes (by the even-odd rule):
 /// they must lie inside it and not overlap one another.
