@@ -94,15 +94,24 @@ fn sheets<'a>(items: &[Item<'a>]) -> Vec<u32> {
     let signs: Vec<f64> = (0..items.len()).into_par_iter().map(sign).collect();
     let sets = Sets::new(items.len());
     let across_of = |item: &Item<'a>| item.sheet.map_or(&[][..], |(_, across)| across);
+    // A pair that names each other is joined from its lesser item alone (ours: half the
+    // joins), where either item's edges run back; a pair named one way, from the item that
+    // names it, where its edges run back.
     items.par_iter().enumerate().for_each(|(i, item)| {
+        let i = i as u32;
         for &j in across_of(item) {
-            let joins = j != NO_ITEM
-                && (j as usize) < items.len()
-                && signs[i] != 0.0
-                && signs[i] == signs[j as usize]
-                && runs_back(items, i as u32, j);
+            if j == NO_ITEM || j as usize >= items.len() {
+                continue;
+            }
+            let named_back = across_of(&items[j as usize]).contains(&i);
+            if named_back && j < i {
+                continue;
+            }
+            let joins = signs[i as usize] != 0.0
+                && signs[i as usize] == signs[j as usize]
+                && (runs_back(items, i, j) || (named_back && runs_back(items, j, i)));
             if joins {
-                sets.join(i as u32, j);
+                sets.join(i, j);
             }
         }
     });
