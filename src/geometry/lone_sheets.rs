@@ -170,9 +170,11 @@ impl Sets {
 /// Whether item `j` names `i` across an edge that runs `i`'s edge the other way.
 fn runs_back(items: &[Item], i: u32, j: u32) -> bool {
     let (Some((ri, ai)), Some((rj, aj))) = (items[i as usize].sheet, items[j as usize].sheet) else { return false };
+    // The corner after `k` of a ring of `n`, stepped round without a division.
+    let next = |k: usize, n: usize| if k + 1 == n { 0 } else { k + 1 };
     (0..ri.len()).filter(|&k| ai[k] == j).all(|k| {
-        let (a, b) = (ri[k], ri[(k + 1) % ri.len()]);
-        (0..rj.len()).any(|m| aj[m] == i && rj[m] == b && rj[(m + 1) % rj.len()] == a)
+        let (a, b) = (ri[k], ri[next(k, ri.len())]);
+        (0..rj.len()).any(|m| aj[m] == i && rj[m] == b && rj[next(m, rj.len())] == a)
     })
 }
 

@@ -1259,8 +1259,10 @@ fn lit_pieces(
         pieces.extend(unshadowed(o, &seen, stats)?);
     }
     stats.backgrounds_found += backs.len() as u64;
+    let boxes: Vec<(DVec2, DVec2)> =
+        if backs.is_empty() { Vec::new() } else { seen.iter().map(|p| p.bounds).collect() };
     for b in backs {
-        let lit = behind_all(b, &seen, stats)?;
+        let lit = behind_all(b, &seen, &boxes, stats)?;
         if let Some(c) = cover.as_deref_mut() {
             c.extend(lit.iter().cloned());
         }
@@ -1281,11 +1283,13 @@ fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> 
     let mut back: Vec<bool> = casters.iter().map(|p| !split(p)).collect();
     let mut order: Vec<usize> = (0..casters.len()).collect();
     order.sort_unstable_by(|&a, &b| casters[a].bounds.0.x.total_cmp(&casters[b].bounds.0.x));
-    let mut active: Vec<usize> = Vec::new();
+    // The casters whose boxes the sweep line is inside, each with its box beside it (ours:
+    // read in one pass, not through the pieces).
+    let mut active: Vec<(usize, (DVec2, DVec2))> = Vec::new();
     for &i in &order {
         let a = &casters[i];
-        active.retain(|&k| casters[k].bounds.1.x >= a.bounds.0.x);
-        for &k in active.iter().filter(|&&k| a.overlaps(&casters[k])) {
+        active.retain(|(_, bounds)| bounds.1.x >= a.bounds.0.x);
+        for &(k, _) in active.iter().filter(|(_, bounds)| boxes_meet(a.bounds, *bounds)) {
             let b = &casters[k];
             // Whether the pair would clear either flag, asked (once their boxes meet) before
             // the dearer question whether their insides meet at all.
@@ -1296,7 +1300,7 @@ fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> 
                 back[k] &= !clears_k;
             }
         }
-        active.push(i);
+        active.push((i, a.bounds));
     }
     back
 }
@@ -1304,13 +1308,19 @@ fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> 
 /// The lit part of `b`, a polygon behind everything it overlaps: where no visible piece of
 /// `seen` covers it. The visible pieces do not overlap one another, so when all those over
 /// `b` lie inside it they become holes in it, as they are, by the even-odd rule (ours: no
-/// clip); otherwise `b` is cut by each.
-fn behind_all(b: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
+/// clip); otherwise `b` is cut by each. `boxes[i]` is `seen[i]`'s box (ours: the pieces are
+/// read only where their boxes meet `b`'s).
+fn behind_all(
+    b: Piece,
+    seen: &[Piece],
+    boxes: &[(DVec2, DVec2)],
+    stats: &mut Pass1,
+) -> std::result::Result<Vec<Piece>, ClipError> {
     // A piece inside `b` meets it; one that is not is asked whether it is apart.
     let within =
         |s: &Piece| b.convex && convex_split::holds(&b.region.rings[0], s.region.rings.iter().flatten().copied());
     let mut holes = Vec::new();
-    for s in seen.iter().filter(|s| s.overlaps(&b)) {
+    for s in boxes.iter().zip(seen).filter(|(bx, _)| boxes_meet(**bx, b.bounds)).map(|(_, s)| s) {
         if within(s) {
             holes.push(s);
         } else if !regions_apart(&s.region, &b.region) {
