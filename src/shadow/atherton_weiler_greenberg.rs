@@ -163,6 +163,11 @@ impl Piece {
     }
 }
 
+/// The least box holding two boxes (least, greatest corner).
+fn box_union(a: (DVec2, DVec2), b: (DVec2, DVec2)) -> (DVec2, DVec2) {
+    (a.0.min(b.0), a.1.max(b.1))
+}
+
 /// Whether two boxes (least, greatest corner) meet, edges included.
 fn boxes_meet(a: (DVec2, DVec2), b: (DVec2, DVec2)) -> bool {
     a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y
@@ -461,7 +466,7 @@ struct Sorting {
 impl Sorting {
     /// An empty sort over the bounds of `list` (`None` when `list` is empty).
     fn new(list: &[Piece]) -> Option<Sorting> {
-        let (lo, hi) = list.iter().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))?;
+        let (lo, hi) = list.iter().map(|p| p.bounds).reduce(box_union)?;
         let g = ((list.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
         let size = (hi - lo).max(DVec2::splat(1e-300));
         let n = list.len();
@@ -888,7 +893,7 @@ fn lit_in_view(
     // Independent regions of the view (one, for up to TILE_PIECES casters), sorted in
     // parallel.
     let all = casters.iter().chain(&others).map(|p| p.bounds);
-    let rect = all.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+    let rect = all.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), box_union);
     // Cutting may copy pieces that straddle a border: at most three more copies in all than
     // there are pieces, however the cuts fall.
     let copies = 3 * (casters.len() + others.len());
@@ -1048,7 +1053,7 @@ const WIDE_TRIED: usize = 16;
 /// over it cut out as holes.
 fn wide_backgrounds(scene: &Scene, m: &Mapped) -> Vec<bool> {
     let mut behind = vec![false; m.polys.len()];
-    let Some((lo, hi)) = m.polys.iter().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else {
+    let Some((lo, hi)) = m.polys.iter().map(|p| p.bounds).reduce(box_union) else {
         return behind;
     };
     let area = |b: (DVec2, DVec2)| (b.1 - b.0).x * (b.1 - b.0).y;
@@ -1062,16 +1067,17 @@ fn wide_backgrounds(scene: &Scene, m: &Mapped) -> Vec<bool> {
         let b = &m.polys[w];
         let ring = m.ring(b);
         behind[w] = m.polys.par_chunks(WIDE_PIECE).enumerate().all(|(k, chunk)| {
-            // Where the candidate holds a piece's whole box, its polygons' corners need no
-            // test of their own (ours: on s3 the floor holds every sphere).
-            let union = chunk.iter().map(|q| q.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
-            let held = union.is_some_and(|u| convex_split::holds_box(ring, u));
-            chunk.iter().enumerate().all(|(j, q)| {
+            // The polygons the candidate must hold: all but itself whose boxes meet its box.
+            let tested =
+                || chunk.iter().enumerate().filter(|&(j, q)| k * WIDE_PIECE + j != w && boxes_meet(q.bounds, b.bounds));
+            // Where the candidate holds their whole box, their corners need no test of their
+            // own (ours: on s3 the floor holds every sphere).
+            let held =
+                tested().map(|(_, q)| q.bounds).reduce(box_union).is_some_and(|u| convex_split::holds_box(ring, u));
+            tested().all(|(_, q)| {
                 let points = || m.ring(q).iter().copied();
-                k * WIDE_PIECE + j == w
-                    || !boxes_meet(q.bounds, b.bounds)
-                    || ((held || convex_split::holds(ring, points()))
-                        && matches!(relation_at(points(), &q.near, &b.near), Relation::Front))
+                (held || convex_split::holds(ring, points()))
+                    && matches!(relation_at(points(), &q.near, &b.near), Relation::Front)
             })
         });
     }
@@ -1109,7 +1115,7 @@ const SPLIT_DEPTH: f64 = 8.0;
 /// of 200 large quads: 20,625 pieces and a pass ten times as long).
 fn stacked(casters: &[Piece], others: &[Piece]) -> bool {
     let all = || casters.iter().chain(others);
-    let Some((lo, hi)) = all().map(|p| p.bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else { return false };
+    let Some((lo, hi)) = all().map(|p| p.bounds).reduce(box_union) else { return false };
     let area = |p: &Piece| p.region.rings.iter().map(|r| signed_area(r).abs()).sum::<f64>();
     all().map(area).sum::<f64>() > SPLIT_DEPTH * (hi - lo).x * (hi - lo).y
 }
@@ -1324,8 +1330,8 @@ fn behind_all(
         if within(s) {
             holes.push(s);
         } else if !regions_apart(&s.region, &b.region) {
-            let over: Vec<Piece> =
-                seen.iter().filter(|s| s.overlaps(&b) && !regions_apart(&s.region, &b.region)).cloned().collect();
+            let meets = boxes.iter().zip(seen).filter(|(bx, _)| boxes_meet(**bx, b.bounds)).map(|(_, s)| s);
+            let over: Vec<Piece> = meets.filter(|s| !regions_apart(&s.region, &b.region)).cloned().collect();
             return outside_all(b, &over, stats);
         }
     }
