@@ -143,12 +143,13 @@ fn named<T: std::str::FromStr<Err = um::Error>>(v: &Bound<'_, PyAny>) -> PyResul
 }
 
 /// Every keyword setting [`stage_settings`] knows, by name.
-const SETTINGS: [(&str, Setter); 31] = [
+const SETTINGS: [(&str, Setter); 32] = [
     ("prefilter", |s, v| v.extract().map(|x| s.bouknight_kelley.prefilter = x)),
     ("sphere_grid", |s, v| v.extract().map(|x| s.bouknight_kelley.sphere_grid = x)),
     ("seen_receivers", |s, v| v.extract().map(|x| s.bouknight_kelley.seen_receivers = x)),
     ("drop_behind", |s, v| v.extract().map(|x| s.bouknight_kelley.drop_behind = x)),
     ("wedge", |s, v| v.extract().map(|x| s.bouknight_kelley.wedge = x)),
+    ("slab", |s, v| v.extract().map(|x| s.bouknight_kelley.slab = x)),
     ("solid_outlines", |s, v| v.extract().map(|x| s.bouknight_kelley.solid_outlines = x)),
     ("own_solid", |s, v| v.extract().map(|x| s.bouknight_kelley.own_solid = x)),
     ("solid_cull", |s, v| {

@@ -217,6 +217,9 @@ fn shadow_polygons(
     if options.wedge {
         counters.add(crate::stats::Counter::PairsOutsideReceiver, total.outside);
     }
+    if options.slab {
+        counters.add(crate::stats::Counter::PairsApart, total.apart);
+    }
     counters.add(crate::stats::Counter::ProjectionsEmpty, total.empty);
     if outlines.is_some() {
         counters.add(crate::stats::Counter::SolidOutlines, total.outlines);
@@ -230,7 +233,8 @@ fn shadow_polygons(
 
 /// Steps 2 and 3 for the receiver `onto` names, `b`: each candidate caster (not a piece of `b`'s own face) is
 /// projected from the light onto `b`'s plane and into the image, unless (ours, with their
-/// switches) it lies wholly behind `b` as the light sees it or outside `b`'s wedge. Returns
+/// switches) it lies wholly behind `b` as the light sees it, outside `b`'s wedge, or apart
+/// from all between the light and `b` ([`Target::apart`]). Returns
 /// the tally, the shadow polygons' edge table, and (for traces) what became of each pair.
 ///
 /// A receiver under more than [`CASTERS_PER_PIECE`] candidates (s3's floor has a million)
@@ -412,6 +416,7 @@ fn project_each(
     let b_verts = scene.verts(b as usize);
     let target = onto.target();
     let wedge = if options.wedge { Wedge::of(b_verts, sample, ctx.extent) } else { None };
+    let margin = 1e-9 * ctx.extent;
     for &a in candidates {
         if scene.polygons[a as usize].face == scene.polygons[b as usize].face {
             continue;
@@ -428,6 +433,8 @@ fn project_each(
             }
         } else if wedge.as_ref().is_some_and(|w| w.misses(a_verts)) {
             tally.outside += 1;
+        } else if options.slab && target.apart(a_verts, scene.polygons[a as usize].plane.n, margin) {
+            tally.apart += 1;
         } else if !proj.project(a_verts, &target) {
             tally.empty += 1;
         } else if ctx.view.clip_project(&proj.shadow, scratch, ring) {
@@ -508,6 +515,7 @@ struct Tally {
     kept: u64,
     behind: u64,
     outside: u64,
+    apart: u64,
     empty: u64,
     prefilter_ns: u64,
     projection_ns: u64,
@@ -523,6 +531,7 @@ impl Tally {
         self.kept += o.kept;
         self.behind += o.behind;
         self.outside += o.outside;
+        self.apart += o.apart;
         self.empty += o.empty;
         self.prefilter_ns += o.prefilter_ns;
         self.projection_ns += o.projection_ns;

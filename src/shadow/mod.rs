@@ -81,6 +81,11 @@ pub struct BouknightKelleyOptions {
     /// cuts from the light (default true; ours): their shadow falls beside the receiver.
     /// `false` projects them, as the paper does.
     pub wedge: bool,
+    /// Drop, without projecting, the casters whose corners' slab across their plane lies
+    /// apart from the part of the light's pyramid over the receiver's rectangle in front of
+    /// the receiver (default true; ours): nothing of them lies between the light and the
+    /// receiver. `false` projects them and finds the projection empty, as the paper does.
+    pub slab: bool,
     /// Drop, before the prefilter, the polygons of closed solids that face away from the
     /// light (default true; ours, not the paper's): on a closed mesh every shadow they cast
     /// is cast by the solid's polygons that face the light. `false` keeps the paper's
@@ -107,6 +112,7 @@ impl BouknightKelleyOptions {
         seen_receivers: true,
         drop_behind: true,
         wedge: true,
+        slab: true,
         solid_cull: true,
         solid_outlines: true,
         own_solid: true,
@@ -120,6 +126,7 @@ impl BouknightKelleyOptions {
         seen_receivers: false,
         drop_behind: false,
         wedge: false,
+        slab: false,
         solid_cull: false,
         solid_outlines: false,
         own_solid: false,
@@ -938,6 +945,7 @@ impl ShadowMethod {
                     on.push((!o.seen_receivers, "--all-receivers".into()));
                     on.push((!o.drop_behind, "--no-drop-behind".into()));
                     on.push((!o.wedge, "--no-wedge".into()));
+                    on.push((!o.slab, "--no-slab".into()));
                     on.push((!o.solid_cull, "--no-solid-cull".into()));
                     on.push((!o.solid_outlines, "--no-solid-outlines".into()));
                     on.push((!o.own_solid, "--no-own-solid".into()));

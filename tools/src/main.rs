@@ -227,6 +227,10 @@ struct ShadowArgs {
     /// as the paper does, instead of dropping them first (ours).
     #[arg(long)]
     no_wedge: bool,
+    /// Bouknight-Kelley: project casters whose plane's slab lies apart from what lies between
+    /// the light and the receiver, as the paper does, instead of dropping them first (ours).
+    #[arg(long)]
+    no_slab: bool,
     /// Bouknight-Kelley: project each polygon of a closed solid onto a receiver under it,
     /// as the paper does, instead of counting the solid's shadow polygons as the outline of
     /// their union (ours).
@@ -390,6 +394,7 @@ impl ShadowArgs {
                 seen_receivers: !self.all_receivers,
                 drop_behind: !self.no_drop_behind,
                 wedge: !self.no_wedge,
+                slab: !self.no_slab,
                 solid_cull: !self.no_solid_cull,
                 solid_outlines: !self.no_solid_outlines,
                 own_solid: !self.no_own_solid,
