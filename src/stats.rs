@@ -144,7 +144,7 @@ counters! {
     PairsDroppedBehind = "pairs_dropped_behind",
     /// Bouknight-Kelley: kept pairs whose caster's shadow misses the receiver (the wedge test).
     PairsOutsideReceiver = "pairs_outside_receiver",
-    /// Bouknight-Kelley: kept pairs whose caster lies apart from all between the light and
+    /// Bouknight-Kelley: kept pairs whose caster lies apart from the hull of the light and
     /// the receiver (the slab test).
     PairsApart = "pairs_apart",
     /// Bouknight-Kelley: the (receiver, closed solid) pairs whose shadow polygons were counted

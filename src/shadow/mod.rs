@@ -82,9 +82,9 @@ pub struct BouknightKelleyOptions {
     /// `false` projects them, as the paper does.
     pub wedge: bool,
     /// Drop, without projecting, the casters whose corners' slab across their plane lies
-    /// apart from the part of the light's pyramid over the receiver's rectangle in front of
-    /// the receiver (default true; ours): nothing of them lies between the light and the
-    /// receiver. `false` projects them and finds the projection empty, as the paper does.
+    /// apart from the hull of the light and the receiver (default true; ours): nothing of
+    /// them lies between the light and the receiver. `false` projects them, as the paper
+    /// does, and finds the projection empty or beside the receiver.
     pub slab: bool,
     /// Drop, before the prefilter, the polygons of closed solids that face away from the
     /// light (default true; ours, not the paper's): on a closed mesh every shadow they cast

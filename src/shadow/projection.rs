@@ -64,9 +64,7 @@ pub struct Target {
     /// [`light_side`] of the plane.
     pub(crate) side: f64,
     /// The faces of the pyramid from the light over `rect`, each as (a point on it, its
-    /// inward normal), worked out when first asked for: of Bouknight-Kelley's 277,000
-    /// receivers on s3, at most 26,600 clip a caster; the others' casters are all dropped
-    /// first.
+    /// inward normal), worked out when first asked for.
     pyramid: std::sync::OnceLock<[(DVec3, DVec3); 4]>,
 }
 
@@ -112,35 +110,6 @@ impl Target {
     /// [`Projector::project`] would find nothing, and need not be asked.
     pub fn misses(&self, verts: &[DVec3]) -> bool {
         self.pyramid().iter().any(|&(origin, m)| verts.iter().all(|&x| m.dot(x - origin) < 0.0))
-    }
-
-    /// Whether polygon `verts` lies apart from all that [`Projector::project`] keeps of a
-    /// polygon, by more than `margin` along `n` (ours, the slab test): its corners span a
-    /// slab across `n` (the polygon's normal, so that the slab is thin), and the part of
-    /// the pyramid on the light's side of the plane (the hull of a point light and the
-    /// rectangle; the prism from the rectangle toward a directional light) lies wholly on
-    /// one side of that slab. Then nothing of the polygon is between the light and the
-    /// rectangle, and the projection would find nothing. On s3 a floor under every sphere
-    /// is such a caster for each of 277,000 receivers on the spheres: it reaches round
-    /// every one of them, so neither the behind test nor the wedge drops it.
-    pub fn apart(&self, verts: &[DVec3], n: DVec3, margin: f64) -> bool {
-        let span = |(lo, hi): (f64, f64), p: &DVec3| (lo.min(n.dot(*p)), hi.max(n.dot(*p)));
-        let none = (f64::INFINITY, f64::NEG_INFINITY);
-        let (lo, hi) = verts.iter().fold(none, span);
-        let (mut rlo, mut rhi) = self.rect.iter().fold(none, span);
-        match self.sample {
-            LightSample::Point(s) => (rlo, rhi) = span((rlo, rhi), &s),
-            // The prism runs from the rectangle against `d`, toward the light.
-            LightSample::Directional(d) => {
-                let along = n.dot(d);
-                if along < 0.0 {
-                    rhi = f64::INFINITY;
-                } else if along > 0.0 {
-                    rlo = f64::NEG_INFINITY;
-                }
-            }
-        }
-        rlo > hi + margin || rhi < lo - margin
     }
 
     /// Whether the box `(lo, hi)` lies wholly outside one face of the pyramid, by a margin
@@ -230,47 +199,6 @@ pub fn bounding_rectangle(verts: &[DVec3], plane: &Plane) -> [DVec3; 4] {
 mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
-
-    /// A polygon the slab test sets apart casts nothing: its projection is empty, under point
-    /// and directional lights; and a floor under the rectangle is set apart from every light
-    /// above it, while many polygons set apart by no single face of the pyramid are too.
-    #[test]
-    fn a_polygon_apart_projects_to_nothing() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1970);
-        let plane = Plane::new(DVec3::Z, DVec3::ZERO);
-        let rect = [
-            DVec3::new(-1.0, -1.0, 0.0),
-            DVec3::new(1.0, -1.0, 0.0),
-            DVec3::new(1.0, 1.0, 0.0),
-            DVec3::new(-1.0, 1.0, 0.0),
-        ];
-        let floor = [-50.0, 50.0].map(|x| [-50.0, 50.0].map(|y| DVec3::new(x, y, -1.0)));
-        let floor = [floor[0][0], floor[1][0], floor[1][1], floor[0][1]];
-        let mut proj = Projector::default();
-        let (mut apart, mut beyond_one_face, mut made, tried) = (0, 0, 0, 4000);
-        for k in 0..tried {
-            let up = DVec3::new(rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0), rng.gen_range(0.5..8.0));
-            let sample = if k % 2 == 0 { LightSample::Point(up) } else { LightSample::Directional(-up.normalize()) };
-            let target = Target::new(plane, rect, sample);
-            assert!(target.apart(&floor, DVec3::Z, 1e-9));
-            let centre = DVec3::new(rng.gen_range(-2.5..2.5), rng.gen_range(-2.5..2.5), rng.gen_range(-2.0..5.0));
-            let (u, v) = (rng.gen_range(0.1..2.0), rng.gen_range(0.1..2.0));
-            let n = DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0))
-                .normalize_or(DVec3::X);
-            let (a, b) = (n.any_orthonormal_vector(), n.cross(n.any_orthonormal_vector()));
-            let verts = [centre - a * u, centre + b * v, centre + a * u * 0.5 - b * v * 0.7];
-            let normal = newell_normal(&verts).normalize_or(n);
-            if target.apart(&verts, normal, 1e-9) {
-                apart += 1;
-                beyond_one_face += !target.misses(&verts) as u32;
-                assert!(!proj.project(&verts, &target), "{verts:?} set apart from {sample:?}, yet casts");
-            } else if proj.project(&verts, &target) {
-                made += 1;
-            }
-        }
-        assert!(apart * 5 > tried && made * 10 > tried, "{apart} apart, {made} casting, of {tried}");
-        assert!(beyond_one_face * 20 > apart, "only {beyond_one_face} of {apart} apart but for one face");
-    }
 
     /// A box the pyramid misses holds no polygon it meets: every polygon inside it is
     /// missed too, and most boxes well away from the pyramid are found to miss it.

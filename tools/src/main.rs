@@ -227,8 +227,8 @@ struct ShadowArgs {
     /// as the paper does, instead of dropping them first (ours).
     #[arg(long)]
     no_wedge: bool,
-    /// Bouknight-Kelley: project casters whose plane's slab lies apart from what lies between
-    /// the light and the receiver, as the paper does, instead of dropping them first (ours).
+    /// Bouknight-Kelley: project casters whose plane's slab lies apart from the hull of the
+    /// light and the receiver, as the paper does, instead of dropping them first (ours).
     #[arg(long)]
     no_slab: bool,
     /// Bouknight-Kelley: project each polygon of a closed solid onto a receiver under it,
