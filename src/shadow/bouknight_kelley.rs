@@ -584,7 +584,7 @@ impl Wedge {
 /// light) by more than `margin` along `n`, the polygon's normal. Its corners span a thin
 /// slab across `n`; when the hull lies wholly on one side of it, no segment from a point of
 /// the receiver to the light meets the polygon, and its shadow misses the receiver. On s3
-/// the floor is such a caster for 268,529 receivers on the spheres: it reaches round each
+/// the floor is such a caster for 268,564 receivers on the spheres: it reaches round each
 /// of them, so neither the behind test nor the wedge drops it, and (as the paper does) it
 /// was projected and clipped to nothing.
 fn apart(sample: LightSample, receiver: &[DVec3], verts: &[DVec3], n: DVec3, margin: f64) -> bool {

@@ -64,35 +64,23 @@ pub struct Target {
     /// [`light_side`] of the plane.
     pub(crate) side: f64,
     /// The faces of the pyramid from the light over `rect`, each as (a point on it, its
-    /// inward normal), worked out when first asked for.
-    pyramid: std::sync::OnceLock<[(DVec3, DVec3); 4]>,
+    /// inward normal).
+    pyramid: [(DVec3, DVec3); 4],
 }
 
 impl Target {
     /// The rectangle `rect` of `plane`, lit by `sample`.
     pub fn new(plane: Plane, rect: [DVec3; 4], sample: LightSample) -> Self {
-        let side = light_side(&plane, sample);
-        Target { plane, rect, sample, side, pyramid: std::sync::OnceLock::new() }
-    }
-
-    /// The pyramid's faces, worked out on the first call.
-    fn pyramid(&self) -> &[(DVec3, DVec3); 4] {
-        self.pyramid.get_or_init(|| self.faces())
-    }
-
-    /// The faces of the pyramid from the light over `rect` (a prism for a directional
-    /// light), each turned to face the rectangle's centre.
-    fn faces(&self) -> [(DVec3, DVec3); 4] {
-        let (rect, sample) = (&self.rect, self.sample);
         let center = rect.iter().sum::<DVec3>() / 4.0;
-        std::array::from_fn(|k| {
+        let pyramid = std::array::from_fn(|k| {
             let (q0, q1) = (rect[k], rect[(k + 1) % 4]);
             let (origin, m) = match sample {
                 LightSample::Point(s) => (s, (q0 - s).cross(q1 - s)),
                 LightSample::Directional(d) => (q0, (q1 - q0).cross(d)),
             };
             (origin, if m.dot(center - origin) >= 0.0 { m } else { -m })
-        })
+        });
+        Target { plane, rect, sample, side: light_side(&plane, sample), pyramid }
     }
 
     /// Point `x` projected from the light onto the plane (`x` between the light and the
@@ -109,7 +97,7 @@ impl Target {
     /// Whether polygon `verts` lies wholly outside one face of the pyramid: then
     /// [`Projector::project`] would find nothing, and need not be asked.
     pub fn misses(&self, verts: &[DVec3]) -> bool {
-        self.pyramid().iter().any(|&(origin, m)| verts.iter().all(|&x| m.dot(x - origin) < 0.0))
+        self.pyramid.iter().any(|&(origin, m)| verts.iter().all(|&x| m.dot(x - origin) < 0.0))
     }
 
     /// Whether the box `(lo, hi)` lies wholly outside one face of the pyramid, by a margin
@@ -118,7 +106,7 @@ impl Target {
     pub fn misses_box(&self, (lo, hi): (DVec3, DVec3)) -> bool {
         let corners = [0, 1, 2, 3, 4, 5, 6, 7]
             .map(|k| DVec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo));
-        self.pyramid().iter().any(|&(origin, m)| {
+        self.pyramid.iter().any(|&(origin, m)| {
             let reach = corners.iter().map(|&c| (c - origin).length()).fold(0.0, f64::max) + origin.length();
             let margin = 1e-9 * m.length() * reach;
             margin.is_finite() && corners.iter().all(|&c| m.dot(c - origin) < -margin)
@@ -155,7 +143,7 @@ impl Projector {
             let ds = plane.distance(s);
             self.clip(|x| (ds - plane.distance(x)) * side);
         }
-        for &(origin, m) in target.pyramid() {
+        for &(origin, m) in &target.pyramid {
             self.clip(|x| m.dot(x - origin));
         }
         if self.shadow.is_empty() {
