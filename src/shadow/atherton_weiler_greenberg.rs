@@ -1325,13 +1325,14 @@ fn behind_all(
     // A piece inside `b` meets it; one that is not is asked whether it is apart.
     let within =
         |s: &Piece| b.convex && convex_split::holds(&b.region.rings[0], s.region.rings.iter().flatten().copied());
+    // The visible pieces whose boxes meet `b`'s.
+    let meeting = || boxes.iter().zip(seen).filter(|(bx, _)| boxes_meet(**bx, b.bounds)).map(|(_, s)| s);
     let mut holes = Vec::new();
-    for s in boxes.iter().zip(seen).filter(|(bx, _)| boxes_meet(**bx, b.bounds)).map(|(_, s)| s) {
+    for s in meeting() {
         if within(s) {
             holes.push(s);
         } else if !regions_apart(&s.region, &b.region) {
-            let meets = boxes.iter().zip(seen).filter(|(bx, _)| boxes_meet(**bx, b.bounds)).map(|(_, s)| s);
-            let over: Vec<Piece> = meets.filter(|s| !regions_apart(&s.region, &b.region)).cloned().collect();
+            let over: Vec<Piece> = meeting().filter(|s| !regions_apart(&s.region, &b.region)).cloned().collect();
             return outside_all(b, &over, stats);
         }
     }

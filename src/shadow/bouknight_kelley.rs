@@ -585,10 +585,13 @@ impl Wedge {
 /// slab across `n`; when the hull lies wholly on one side of it, no segment from a point of
 /// the receiver to the light meets the polygon, and its shadow misses the receiver. On s3
 /// the floor is such a caster for 268,564 receivers on the spheres: it reaches round each
-/// of them, so neither the behind test nor the wedge drops it, and (as the paper does) it
-/// was projected and clipped to nothing.
+/// of them, so neither the behind test nor the wedge drops it, and without this test it is
+/// projected, as the paper does, and clipped to nothing.
 fn apart(sample: LightSample, receiver: &[DVec3], verts: &[DVec3], n: DVec3, margin: f64) -> bool {
-    let span = |(lo, hi): (f64, f64), p: &DVec3| (lo.min(n.dot(*p)), hi.max(n.dot(*p)));
+    let span = |(lo, hi): (f64, f64), p: &DVec3| {
+        let d = n.dot(*p);
+        (lo.min(d), hi.max(d))
+    };
     let none = (f64::INFINITY, f64::NEG_INFINITY);
     let (lo, hi) = verts.iter().fold(none, span);
     let (mut rlo, mut rhi) = receiver.iter().fold(none, span);
