@@ -50,6 +50,23 @@ pub(crate) fn joined<S: Sync, T: Copy + Send + Sync>(parts: &[&[S]], f: impl Fn(
     list
 }
 
+/// The `(key, item)` pairs grouped by key, by all threads: each key beside its items in
+/// increasing order, the keys in increasing order (found by sorting, where a hash map would
+/// be filled on one thread).
+pub(crate) fn grouped(mut pairs: Vec<(u32, u32)>) -> Vec<(u32, Vec<u32>)> {
+    pairs.par_sort_unstable();
+    let starts: Vec<usize> =
+        (0..pairs.len()).into_par_iter().filter(|&j| j == 0 || pairs[j].0 != pairs[j - 1].0).collect();
+    starts
+        .par_iter()
+        .enumerate()
+        .map(|(g, &a)| {
+            let b = starts.get(g + 1).copied().unwrap_or(pairs.len());
+            (pairs[a].0, pairs[a..b].iter().map(|&(_, i)| i).collect())
+        })
+        .collect()
+}
+
 /// `n` copies of `v`, written by all threads: the first writes to a list's fresh pages are
 /// most of the cost of making it (a 1080p frame's colour and ids, 33 MB, made on one thread
 /// were the largest serial step of a one-frame render).
@@ -133,6 +150,20 @@ pub(crate) fn sort_by_high_half(keys: &mut [u64], bits: u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn grouped_lists_each_keys_items_in_order_the_keys_in_order() {
+        // Enough pairs for the parallel sort to cut them, in scrambled order.
+        let pairs: Vec<(u32, u32)> = (0..5_000u32).rev().map(|i| ((i * 7919) % 13, i)).collect();
+        let groups = grouped(pairs);
+        assert_eq!(groups.iter().map(|g| g.0).collect::<Vec<_>>(), (0..13).collect::<Vec<_>>());
+        for (key, items) in &groups {
+            assert!(items.windows(2).all(|w| w[0] < w[1]));
+            assert!(items.iter().all(|&i| (i * 7919) % 13 == *key));
+        }
+        assert_eq!(groups.iter().map(|g| g.1.len()).sum::<usize>(), 5_000);
+        assert!(grouped(Vec::new()).is_empty());
+    }
 
     #[test]
     fn marked_flags_each_index_given_once_or_many_times() {

@@ -57,11 +57,8 @@ pub(crate) fn find(items: &[Item]) -> Lone {
     let root = sheets(items);
     // Each sheet's members, by root, and whether its boundary is one simple loop (the
     // sheets in parallel).
-    let mut by_root: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
-    for i in (0..n).filter(|&i| root[i] != NO_ITEM) {
-        by_root.entry(root[i]).or_default().push(i as u32);
-    }
-    let members: Vec<(u32, Vec<u32>)> = by_root.into_iter().collect();
+    let pairs = root.par_iter().enumerate().filter(|(_, &r)| r != NO_ITEM).map(|(i, &r)| (r, i as u32));
+    let members = crate::pieces::grouped(pairs.collect());
     // `valid[r]`: whether the sheet rooted at item `r` clears itself.
     let mut valid = vec![false; n];
     for (r, ok) in members.par_iter().map(|(r, m)| (*r, clears_itself(items, &root, m))).collect::<Vec<_>>() {

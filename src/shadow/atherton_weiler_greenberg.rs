@@ -808,8 +808,13 @@ impl Mapped {
         let mut parts: Vec<Mapped> = (0..n.div_ceil(MAP_PIECE))
             .into_par_iter()
             .map(|k| {
-                let (mut m, mut scratch) = (Mapped::default(), [Vec::new(), Vec::new()]);
-                for i in (k * MAP_PIECE..n.min((k + 1) * MAP_PIECE)).filter(|&i| !unseen(i)) {
+                let seen: Vec<usize> = (k * MAP_PIECE..n.min((k + 1) * MAP_PIECE)).filter(|&i| !unseen(i)).collect();
+                // Room for every polygon the view may see, whole (ours: lists grown as they
+                // fill are copied again at each doubling).
+                let corners = seen.iter().map(|&i| scene.verts(i).len()).sum();
+                let mut m = Mapped { points: Vec::with_capacity(corners), polys: Vec::with_capacity(seen.len()) };
+                let mut scratch = [Vec::new(), Vec::new()];
+                for i in seen {
                     m.push(scene, view, i, 1e-9 * extent, &mut scratch);
                 }
                 // The parts and the joined view exist at once: no part keeps room to spare.
@@ -1053,11 +1058,13 @@ const WIDE_TRIED: usize = 16;
 /// over it cut out as holes.
 fn wide_backgrounds(scene: &Scene, m: &Mapped) -> Vec<bool> {
     let mut behind = vec![false; m.polys.len()];
-    let Some((lo, hi)) = m.polys.iter().map(|p| p.bounds).reduce(box_union) else {
+    // The view's box and its wide polygons, found by all threads.
+    let Some((lo, hi)) = m.polys.par_iter().map(|p| p.bounds).reduce_with(box_union) else {
         return behind;
     };
     let area = |b: (DVec2, DVec2)| (b.1 - b.0).x * (b.1 - b.0).y;
     let mut wide: Vec<usize> = (0..m.polys.len())
+        .into_par_iter()
         .filter(|&i| area(m.polys[i].bounds) * 64.0 >= area((lo, hi)))
         .filter(|&i| !m.polys[i].crossing && is_convex(m.ring(&m.polys[i])))
         .filter(|&i| !scene.fan_piece(m.polys[i].source as usize))
@@ -1535,19 +1542,8 @@ fn overlay(ctx: &ShadowContext, wholes: &[u32], screen: OnScreen, counters: &mut
 /// source polygon, each group in screen order and the groups in the order their sources
 /// first come: found by sorting, by all threads.
 fn grouped_by_source(screen: &[(u32, Vec<Vec<DVec2>>)]) -> Vec<(u32, Vec<u32>)> {
-    let mut order: Vec<(u32, u32)> =
-        screen.par_iter().enumerate().filter(|(_, s)| !s.1.is_empty()).map(|(i, s)| (s.0, i as u32)).collect();
-    order.par_sort_unstable();
-    let starts: Vec<usize> =
-        (0..order.len()).into_par_iter().filter(|&j| j == 0 || order[j].0 != order[j - 1].0).collect();
-    let mut groups: Vec<(u32, Vec<u32>)> = starts
-        .par_iter()
-        .enumerate()
-        .map(|(g, &a)| {
-            let b = starts.get(g + 1).copied().unwrap_or(order.len());
-            (order[a].0, order[a..b].iter().map(|&(_, i)| i).collect())
-        })
-        .collect();
+    let pairs = screen.par_iter().enumerate().filter(|(_, s)| !s.1.is_empty()).map(|(i, s)| (s.0, i as u32));
+    let mut groups = pieces::grouped(pairs.collect());
     groups.par_sort_unstable_by_key(|(_, members)| members[0]);
     groups
 }
