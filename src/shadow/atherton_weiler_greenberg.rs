@@ -758,8 +758,8 @@ fn cube_face(p: DVec3) -> Option<u8> {
 /// Per light view (`views` of them), the polygons it may see, in increasing order: all but
 /// the `unseen`, less those that `face` (from [`cube_faces`]; empty for none) puts wholly in
 /// another view. One pass sorts the polygons into each view's own list and one list that
-/// every view shares (ours: each view scanning the whole scene was 6 million tests a frame
-/// on s3).
+/// every view shares (ours: each view scanning the whole scene would make 6 million tests a
+/// frame on s3).
 fn view_lists(face: &[Option<u8>], unseen: &[bool], views: usize) -> Vec<Vec<u32>> {
     let n = unseen.len();
     let parts: Vec<Vec<Vec<u32>>> = (0..n.div_ceil(MAP_PIECE))
