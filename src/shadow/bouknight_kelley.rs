@@ -833,9 +833,16 @@ impl SphereGrid {
         for (c, r) in self.cells_of(b) {
             let cell = self.cell(c, r);
             match own.and_then(|o| Some((o, o.stretch(cell)?))) {
+                // Three loops, not one over the three lists chained: a chained iterator asks
+                // which list it is in at every step (ours; 2.7% of s3's preparation).
                 Some((o, (start, end))) => {
-                    let front = o.front.iter().filter(|&&f| self.holds(f, c, r));
-                    for &a in cell[..start].iter().chain(front).chain(&cell[end..]) {
+                    for &a in &cell[..start] {
+                        self.offer(a, b, stamp, out);
+                    }
+                    for &a in o.front.iter().filter(|&&f| self.holds(f, c, r)) {
+                        self.offer(a, b, stamp, out);
+                    }
+                    for &a in &cell[end..] {
                         self.offer(a, b, stamp, out);
                     }
                 }
