@@ -294,10 +294,14 @@ impl Grid {
         let cells: Vec<AtomicU32> = (0..g.0 * g.1).into_par_iter().map(|_| AtomicU32::new(EMPTY)).collect();
         items.par_iter().enumerate().for_each(|(i, item)| {
             let o = owner(i);
-            for (c, r) in grid_cells(lo, size, g, item.bounds) {
-                let merge =
-                    |cell: u32| (cell != o && cell != CONFLICT).then_some(if cell == EMPTY { o } else { CONFLICT });
-                let _ = cells[c * g.1 + r].fetch_update(Ordering::Relaxed, Ordering::Relaxed, merge);
+            let merge = |cell: u32| (cell != o && cell != CONFLICT).then_some(if cell == EMPTY { o } else { CONFLICT });
+            // Nested loops over the rectangle: an iterator of iterators asks at every step
+            // which one it is in.
+            let (c0, c1, r0, r1) = grid_rectangle(lo, size, g, item.bounds);
+            for column in cells[c0 * g.1..(c1 + 1) * g.1].chunks(g.1) {
+                for cell in &column[r0..=r1] {
+                    let _ = cell.fetch_update(Ordering::Relaxed, Ordering::Relaxed, merge);
+                }
             }
         });
         Some(Grid { cells, lo, size, g })
