@@ -316,11 +316,12 @@ fn splits(q: &Piece, by: &Piece, stats: &Pass1) -> bool {
 fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
     stats.depth_max = stats.depth_max.max(depth);
     let Some(mut sort) = Sorting::new(&list) else { return Ok(Vec::new()) };
+    // Room for as many visible pieces as there are pieces to sort (most stay whole).
+    let mut out = Vec::with_capacity(list.len());
     for p in list {
         let key = OrdF64(p.nearest());
         sort.add(p, key);
     }
-    let mut out = Vec::new();
     while let Some((_, std::cmp::Reverse(fi))) = sort.heap.pop() {
         let Some(front) = sort.arena[fi as usize].take() else { continue };
         // The front polygon's outline splits everything it overlaps into inside and outside.
@@ -1234,9 +1235,14 @@ fn median_centre(pieces: &[Piece]) -> Option<DVec2> {
 
 /// Each piece into the quarters its box overlaps, cut to each when it crosses a border.
 fn into_quarters(pieces: Vec<Piece>, quarters: &[(DVec2, DVec2); 4]) -> [Vec<Piece>; 4] {
-    let mut out: [Vec<Piece>; 4] = Default::default();
+    let hits = |b: (DVec2, DVec2)| (0..4).filter(move |&k| touches(b, quarters[k]));
+    // Each quarter is given its room at once: grown as they filled, the lists were copied
+    // at each doubling.
+    let mut counts = [0; 4];
+    pieces.iter().flat_map(|p| hits(p.bounds)).for_each(|k| counts[k] += 1);
+    let mut out = counts.map(Vec::with_capacity);
     for p in pieces {
-        let hit: smallvec::SmallVec<[usize; 4]> = (0..4).filter(|&k| touches(p.bounds, quarters[k])).collect();
+        let hit: smallvec::SmallVec<[usize; 4]> = hits(p.bounds).collect();
         if let [k] = hit[..] {
             out[k].push(p);
             continue;
@@ -1288,11 +1294,14 @@ fn lit_pieces(
         *pieces_of.entry(face(c)).or_default() += 1;
     }
     let split = |p: &Piece| pieces_of.get(&face(p)).is_some_and(|&n| n > 1);
-    let (mut kept, mut backs) = (Vec::new(), Vec::new());
     // Backgrounds leave the sort where every polygon here casts shadows: a polygon that
     // casts none is lit against the visible parts of every caster (`unshadowed`), and a
     // background's would be missing.
     let back = if stats.backgrounds && others.is_empty() { backgrounds(&casters, &split) } else { Vec::new() };
+    // Each list is given its room at once (ours: grown as they filled, the two lists of a
+    // region's pieces were copied at each doubling).
+    let behind = back.iter().filter(|&&b| b).count();
+    let (mut kept, mut backs) = (Vec::with_capacity(casters.len() - behind), Vec::with_capacity(behind));
     for (i, c) in casters.into_iter().enumerate() {
         if back.get(i) == Some(&true) {
             backs.push(c);
