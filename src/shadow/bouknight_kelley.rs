@@ -930,8 +930,7 @@ const BOX_SLACK: f64 = 1e-9;
 
 /// A cone's boxes in the [`SPHERE`] domain, height × pseudo-azimuth (two where the azimuth
 /// wraps; the whole domain for the whole sphere), found without an arccosine or an
-/// arctangent (ours). For a cone of half-angle
-/// `h` round an axis of polar angle `θ`:
+/// arctangent (ours). For a cone of half-angle `h` round an axis of polar angle `θ`:
 /// - the heights run from `cos(θ + h)` to `cos(θ − h)`, that is `y cos h ∓ sin θ sin h`,
 ///   out to ±1 where a pole lies inside the cone;
 /// - the azimuths run `asin(x)` either side of the axis's, `x = sin h / sin θ`; its two
