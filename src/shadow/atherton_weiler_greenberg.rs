@@ -1236,8 +1236,8 @@ fn median_centre(pieces: &[Piece]) -> Option<DVec2> {
 /// Each piece into the quarters its box overlaps, cut to each when it crosses a border.
 fn into_quarters(pieces: Vec<Piece>, quarters: &[(DVec2, DVec2); 4]) -> [Vec<Piece>; 4] {
     let hits = |b: (DVec2, DVec2)| (0..4).filter(move |&k| touches(b, quarters[k]));
-    // Each quarter is given its room at once: grown as they filled, the lists were copied
-    // at each doubling.
+    // Each quarter is given its room at once: a list grown as it fills is copied at each
+    // doubling.
     let mut counts = [0; 4];
     pieces.iter().flat_map(|p| hits(p.bounds)).for_each(|k| counts[k] += 1);
     let mut out = counts.map(Vec::with_capacity);
@@ -1298,8 +1298,8 @@ fn lit_pieces(
     // casts none is lit against the visible parts of every caster (`unshadowed`), and a
     // background's would be missing.
     let back = if stats.backgrounds && others.is_empty() { backgrounds(&casters, &split) } else { Vec::new() };
-    // Each list is given its room at once (ours: grown as they filled, the two lists of a
-    // region's pieces were copied at each doubling).
+    // Each list is given its room at once (ours: a list grown as it fills is copied at
+    // each doubling).
     let behind = back.iter().filter(|&&b| b).count();
     let (mut kept, mut backs) = (Vec::with_capacity(casters.len() - behind), Vec::with_capacity(behind));
     for (i, c) in casters.into_iter().enumerate() {
