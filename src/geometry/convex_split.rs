@@ -22,6 +22,7 @@
 use super::weiler_atherton::{ring_bounds, signed_area, Ring};
 use glam::DVec2;
 use smallvec::SmallVec;
+use std::borrow::Cow;
 
 /// The two parts of a convex subject split by a convex clip polygon.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -57,7 +58,9 @@ pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Option<Split> {
     if s_turn == 0.0 || c_turn == 0.0 || apart(subject, s_turn, clip, eps) || apart(clip, c_turn, subject, eps) {
         return None;
     }
-    let mut rest = subject.to_vec();
+    // What is left is the subject itself until a line cuts it (ours: a line that leaves it
+    // whole makes no copy).
+    let mut rest = Cow::Borrowed(subject);
     let mut outside = SmallVec::new();
     let n = clip.len();
     for i in 0..n {
@@ -66,26 +69,53 @@ pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Option<Split> {
             continue; // a repeated corner bounds nothing
         }
         let line = Line::through(a, b, c_turn);
-        let (inner, outer) = cut(&rest, |p| line.distance(p), eps);
-        outside.extend(outer);
-        // None: touching within the tolerance only, nothing of the subject is inside.
-        rest = inner?;
+        match sides(&rest, |p| line.distance(p), eps) {
+            Sides::Positive => {}
+            // Touching within the tolerance only: nothing of the subject is inside.
+            Sides::Negative | Sides::On => return None,
+            Sides::Both(inner, outer) => {
+                outside.push(outer);
+                rest = Cow::Owned(inner);
+            }
+        }
     }
-    Some(Split { inside: rest, outside })
+    Some(Split { inside: rest.into_owned(), outside })
 }
 
 /// Cuts `ring` by the line whose signed distance is `dist` (positive on the kept side): the
 /// parts on the positive and on the negative side, each `None` when nothing of the ring lies
 /// more than `eps` on that side. Either is the ring itself when the other is `None`.
 pub fn cut(ring: &[DVec2], dist: impl Fn(DVec2) -> f64, eps: f64) -> (Option<Ring>, Option<Ring>) {
+    match sides(ring, dist, eps) {
+        Sides::Positive => (Some(ring.to_vec()), None),
+        Sides::Negative => (None, Some(ring.to_vec())),
+        Sides::On => (None, None),
+        Sides::Both(inner, outer) => (Some(inner), Some(outer)),
+    }
+}
+
+/// Where a ring lies against a line ([`cut`]).
+enum Sides {
+    /// Nothing more than `eps` on the negative side, something on the positive side.
+    Positive,
+    /// The other way round.
+    Negative,
+    /// Every corner within `eps` of the line.
+    On,
+    /// Cut: the parts on the positive and on the negative side.
+    Both(Ring, Ring),
+}
+
+/// [`cut`], with a ring the line does not cut named, not copied.
+fn sides(ring: &[DVec2], dist: impl Fn(DVec2) -> f64, eps: f64) -> Sides {
     let snap = |d: f64| if d.abs() <= eps { 0.0 } else { d };
     let d: SmallVec<[f64; 16]> = ring.iter().map(|&p| snap(dist(p))).collect();
     let (pos, neg) = (d.iter().any(|&x| x > 0.0), d.iter().any(|&x| x < 0.0));
-    if !neg {
-        return (pos.then(|| ring.to_vec()), None);
-    }
-    if !pos {
-        return (None, Some(ring.to_vec()));
+    match (pos, neg) {
+        (true, false) => return Sides::Positive,
+        (false, true) => return Sides::Negative,
+        (false, false) => return Sides::On,
+        (true, true) => {}
     }
     let (mut inner, mut outer) = (Vec::with_capacity(ring.len() + 1), Vec::with_capacity(ring.len() + 1));
     let n = ring.len();
@@ -103,7 +133,7 @@ pub fn cut(ring: &[DVec2], dist: impl Fn(DVec2) -> f64, eps: f64) -> (Option<Rin
             outer.push(x);
         }
     }
-    (Some(inner), Some(outer))
+    Sides::Both(inner, outer)
 }
 
 /// A directed line's signed distance, positive on the side a polygon turning `turn` (+1

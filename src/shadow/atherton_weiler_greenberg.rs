@@ -279,8 +279,9 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
     Ok(Piece::new(q.source, c.inside, q.near))
 }
 
-/// A piece's parts inside and outside another.
-type Parts = (Vec<Piece>, Vec<Piece>);
+/// A piece's part inside another (one at most: a region, or what is left after the last
+/// split), and its parts outside.
+type Parts = (Option<Piece>, Vec<Piece>);
 
 /// `q` cut by the outline of `by`: its parts inside `by` and outside it, or `None` when
 /// nothing of it is inside (`q` stays as it is). Two convex pieces are split by `by`'s edges
@@ -291,7 +292,7 @@ fn cut(q: &Piece, by: &Piece, stats: &mut Pass1) -> std::result::Result<Option<P
         let Some(s) = convex_split::split(&q.region.rings[0], &by.region.rings[0]) else { return Ok(None) };
         stats.clips += 1;
         let piece = |r| Piece::convex(q.source, r, q.near);
-        return Ok(Some((piece(s.inside).into_iter().collect(), s.outside.into_iter().filter_map(piece).collect())));
+        return Ok(Some((piece(s.inside), s.outside.into_iter().filter_map(piece).collect())));
     }
     stats.clips += 1;
     let c = clip(&q.region, &by.region)?;
@@ -299,7 +300,7 @@ fn cut(q: &Piece, by: &Piece, stats: &mut Pass1) -> std::result::Result<Option<P
         return Ok(None);
     }
     let piece = |r| Piece::new(q.source, r, q.near);
-    Ok(Some((piece(c.inside).into_iter().collect(), piece(c.outside).into_iter().collect())))
+    Ok(Some((piece(c.inside), piece(c.outside).into_iter().collect())))
 }
 
 /// Whether [`cut`] splits `q` by `by`'s edges (both convex, and splitting on).
@@ -377,9 +378,9 @@ const PARALLEL_CUTS: usize = 16;
 /// at every front polygon.
 const CUTS_PER_PIECE: usize = 4;
 
-/// A piece's parts inside the front polygon that are not wholly behind it (with how they
-/// lie), and its parts outside.
-type Sorted = (Vec<(Piece, Relation)>, Vec<Piece>);
+/// A piece's part inside the front polygon unless it is wholly behind it (with how it lies),
+/// and its parts outside.
+type Sorted = (Option<(Piece, Relation)>, Vec<Piece>);
 
 /// Each of `taken` cut by `front`'s outline ([`cut`]), in order, with the parts inside
 /// wholly behind `front` dropped (hidden): in parallel where there are many and Weiler and
@@ -400,7 +401,7 @@ fn cut_all(
                 Relation::Behind => None,
                 r => Some((q, r)),
             };
-            (ins.into_iter().filter_map(not_behind).collect(), outs)
+            (ins.and_then(not_behind), outs)
         }))
     };
     if taken.len() < PARALLEL_CUTS || stats.convex_split {
@@ -574,7 +575,7 @@ fn unshadowed(o: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Resul
             };
             next.extend(outside);
             // Over the overlap, the caster hides `o` where it is nearer.
-            for overlap in inside {
+            if let Some(overlap) = inside {
                 let caster = Piece { near: s.near, ..overlap.clone() };
                 match relation(&caster, &overlap) {
                     Relation::Behind => next.push(overlap),
