@@ -84,7 +84,8 @@ pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Option<Split> {
 
 /// Cuts `ring` by the line whose signed distance is `dist` (positive on the kept side): the
 /// parts on the positive and on the negative side, each `None` when nothing of the ring lies
-/// more than `eps` on that side. Either is the ring itself when the other is `None`.
+/// more than `eps` on that side (both, for a ring wholly within `eps` of the line). Where only
+/// one side has a part, that part is the ring itself.
 pub fn cut(ring: &[DVec2], dist: impl Fn(DVec2) -> f64, eps: f64) -> (Option<Ring>, Option<Ring>) {
     match sides(ring, dist, eps) {
         Sides::Positive => (Some(ring.to_vec()), None),
