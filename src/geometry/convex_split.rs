@@ -82,20 +82,18 @@ pub fn split(subject: &[DVec2], clip: &[DVec2]) -> Option<Split> {
     Some(Split { inside: rest.into_owned(), outside })
 }
 
-/// Cuts `ring` by the line whose signed distance is `dist` (positive on the kept side): the
-/// parts on the positive and on the negative side, each `None` when nothing of the ring lies
-/// more than `eps` on that side (both, for a ring wholly within `eps` of the line). Where only
-/// one side has a part, that part is the ring itself.
-pub fn cut(ring: &[DVec2], dist: impl Fn(DVec2) -> f64, eps: f64) -> (Option<Ring>, Option<Ring>) {
+/// The part of `ring` on the positive side of the line whose signed distance is `dist`:
+/// `None` when nothing of the ring lies more than `eps` on that side, the ring itself when
+/// nothing lies more than `eps` on the other.
+pub fn positive_part(ring: &[DVec2], dist: impl Fn(DVec2) -> f64, eps: f64) -> Option<Ring> {
     match sides(ring, dist, eps) {
-        Sides::Positive => (Some(ring.to_vec()), None),
-        Sides::Negative => (None, Some(ring.to_vec())),
-        Sides::On => (None, None),
-        Sides::Both(inner, outer) => (Some(inner), Some(outer)),
+        Sides::Positive => Some(ring.to_vec()),
+        Sides::Both(inner, _) => Some(inner),
+        Sides::Negative | Sides::On => None,
     }
 }
 
-/// Where a ring lies against a line ([`cut`]).
+/// Where a ring lies against a line, cut by it where it has parts on both sides.
 enum Sides {
     /// Nothing more than `eps` on the negative side, something on the positive side.
     Positive,
@@ -107,7 +105,9 @@ enum Sides {
     Both(Ring, Ring),
 }
 
-/// [`cut`], with a ring the line does not cut named, not copied.
+/// Where `ring` lies against the line whose signed distance is `dist` (positive on the kept
+/// side), corners within `eps` of it on it: a ring the line does not cut is named, not
+/// copied.
 fn sides(ring: &[DVec2], dist: impl Fn(DVec2) -> f64, eps: f64) -> Sides {
     let snap = |d: f64| if d.abs() <= eps { 0.0 } else { d };
     let d: SmallVec<[f64; 16]> = ring.iter().map(|&p| snap(dist(p))).collect();

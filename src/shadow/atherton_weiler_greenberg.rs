@@ -262,7 +262,7 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
             return Ok((dc > 0.0).then(|| q.clone()));
         }
         let eps = crate::geometry::tolerance(lo, hi);
-        let (front, _) = convex_split::cut(&q.region.rings[0], |p| (da * p.x + db * p.y + dc) / norm, eps);
+        let front = convex_split::positive_part(&q.region.rings[0], |p| (da * p.x + db * p.y + dc) / norm, eps);
         return Ok(front.and_then(|r| Piece::convex(q.source, r, q.near)));
     }
     let pad = (hi - lo).max_element().max(1e-12);
