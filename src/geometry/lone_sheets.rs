@@ -33,7 +33,8 @@ pub(crate) struct Item<'a> {
     pub bounds: (DVec2, DVec2),
     /// For a polygon that may belong to a sheet: its outline, and for each edge (from
     /// corner `k` to `k + 1`) the item across it, or [`NO_ITEM`]. The item across must run
-    /// the same two points the other way.
+    /// the same two points the other way and name this item across that edge, or have no
+    /// `sheet` (debug builds check it): the joins trust it.
     pub sheet: Option<(&'a [DVec2], &'a [u32])>,
 }
 
@@ -44,6 +45,9 @@ pub(crate) struct Lone {
     pub lone: Vec<bool>,
     /// Per sheet with lone polygons: one of them, and the rings of their union's boundary.
     pub outlines: Vec<(u32, Vec<Vec<DVec2>>)>,
+    /// `sheet[i]`: the sheet of item `i` (its least item) where that sheet clears itself, so
+    /// that no two of its items overlap; [`NO_ITEM`] for any other item.
+    pub sheet: Vec<u32>,
 }
 
 /// Grid cells marked per item, on average, beyond which [`find`] gives up (a crowd of large
@@ -53,7 +57,7 @@ const MARKS_PER_ITEM: usize = 16;
 /// The lone items of `items`, and the outlines of each sheet's lone items.
 pub(crate) fn find(items: &[Item]) -> Lone {
     let n = items.len();
-    let mut lone = Lone { lone: vec![false; n], outlines: Vec::new() };
+    let mut lone = Lone { lone: vec![false; n], outlines: Vec::new(), sheet: Vec::new() };
     let root = sheets(items);
     // Each sheet's members, by root, and whether its boundary is one simple loop (the
     // sheets in parallel).
@@ -65,6 +69,7 @@ pub(crate) fn find(items: &[Item]) -> Lone {
         valid[r as usize] = ok;
     }
     let in_valid = |i: usize| root[i] != NO_ITEM && valid[root[i] as usize];
+    lone.sheet = (0..n).into_par_iter().map(|i| if in_valid(i) { root[i] } else { NO_ITEM }).collect();
     // The grid: each cell holds the one owner whose boxes meet it, or CONFLICT.
     let owner = |i: usize| if in_valid(i) { root[i] } else { (n + i) as u32 };
     let Some(grid) = Grid::new(items, owner) else { return lone };
@@ -80,9 +85,9 @@ pub(crate) fn find(items: &[Item]) -> Lone {
 }
 
 /// Each item's sheet (the least item of it), or [`NO_ITEM`] for items that are in none: the
-/// items joined across their shared edges where both are wound the same way. Every edge is
-/// tested, and its pair joined, by all threads ([`Sets`]): each set's root is its least
-/// member, whatever the order of the joins.
+/// items joined across their shared edges where both are wound the same way. Every pair is
+/// joined by all threads ([`Sets`]): each set's root is its least member, whatever the order
+/// of the joins.
 fn sheets<'a>(items: &[Item<'a>]) -> Vec<u32> {
     let sign = |i: usize| {
         let a = items[i].sheet.map_or(0.0, |(ring, _)| signed_area(ring));
@@ -91,23 +96,16 @@ fn sheets<'a>(items: &[Item<'a>]) -> Vec<u32> {
     let signs: Vec<f64> = (0..items.len()).into_par_iter().map(sign).collect();
     let sets = Sets::new(items.len());
     let across_of = |item: &Item<'a>| item.sheet.map_or(&[][..], |(_, across)| across);
-    // A pair that names each other is joined from its lesser item alone (ours: half the
-    // joins), where either item's edges run back; a pair named one way, from the item that
-    // names it, where its edges run back.
+    // A pair names each other ([`Item::sheet`]), and is joined from its lesser item alone
+    // (ours: half the joins), its shared edges taken as they are named: they run back.
     items.par_iter().enumerate().for_each(|(i, item)| {
         let i = i as u32;
         for &j in across_of(item) {
-            if j == NO_ITEM || j as usize >= items.len() {
+            if j == NO_ITEM || j < i || j as usize >= items.len() || items[j as usize].sheet.is_none() {
                 continue;
             }
-            let named_back = across_of(&items[j as usize]).contains(&i);
-            if named_back && j < i {
-                continue;
-            }
-            let joins = signs[i as usize] != 0.0
-                && signs[i as usize] == signs[j as usize]
-                && (runs_back(items, i, j) || (named_back && runs_back(items, j, i)));
-            if joins {
+            debug_assert!(runs_back(items, i, j) && runs_back(items, j, i), "items {i} and {j} do not run back");
+            if signs[i as usize] != 0.0 && signs[i as usize] == signs[j as usize] {
                 sets.join(i, j);
             }
         }
@@ -164,7 +162,8 @@ impl Sets {
     }
 }
 
-/// Whether item `j` names `i` across an edge that runs `i`'s edge the other way.
+/// Whether item `j` names `i` across every edge of `i` that names `j`, and runs it the
+/// other way ([`Item::sheet`]'s promise, checked in debug builds).
 fn runs_back(items: &[Item], i: u32, j: u32) -> bool {
     let (Some((ri, ai)), Some((rj, aj))) = (items[i as usize].sheet, items[j as usize].sheet) else { return false };
     // The corner after `k` of a ring of `n`, stepped round without a division.

@@ -137,20 +137,38 @@ struct Piece {
     convex: bool,
     /// Whether the region is the whole source polygon, one ring with its corners in order.
     whole: bool,
+    /// The lone-sheet step's sheet of its polygon (ours, [`lone_sheets`]), or [`NO_ITEM`]:
+    /// no two pieces of one sheet overlap.
+    sheet: u32,
 }
 
 impl Piece {
     fn new(source: u32, region: Region, near: DepthPlane) -> Option<Piece> {
         let bounds = region.bounds()?;
         let convex = region.rings.len() == 1 && is_convex(&region.rings[0]);
-        Some(Piece { source, region, near, bounds, convex, whole: false })
+        Some(Piece { source, region, near, bounds, convex, whole: false, sheet: NO_ITEM })
     }
 
     /// A piece known to be one convex ring.
     fn convex(source: u32, ring: Ring, near: DepthPlane) -> Option<Piece> {
         let region = Region::from_ring(ring);
         let bounds = region.bounds()?;
-        Some(Piece { source, region, near, bounds, convex: true, whole: false })
+        Some(Piece { source, region, near, bounds, convex: true, whole: false, sheet: NO_ITEM })
+    }
+
+    /// A part of this piece: `region`, which lies inside it.
+    fn part(&self, region: Region) -> Option<Piece> {
+        Some(Piece { sheet: self.sheet, ..Piece::new(self.source, region, self.near)? })
+    }
+
+    /// A part of this piece known to be one convex ring.
+    fn convex_part(&self, ring: Ring) -> Option<Piece> {
+        Some(Piece { sheet: self.sheet, ..Piece::convex(self.source, ring, self.near)? })
+    }
+
+    /// Whether the two pieces lie on one sheet, where their insides cannot meet.
+    fn same_sheet(&self, other: &Piece) -> bool {
+        self.sheet != NO_ITEM && self.sheet == other.sheet
     }
 
     fn overlaps(&self, other: &Piece) -> bool {
@@ -263,7 +281,7 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
         }
         let eps = crate::geometry::tolerance(lo, hi);
         let front = convex_split::positive_part(&q.region.rings[0], |p| (da * p.x + db * p.y + dc) / norm, eps);
-        return Ok(front.and_then(|r| Piece::convex(q.source, r, q.near)));
+        return Ok(front.and_then(|r| q.convex_part(r)));
     }
     let pad = (hi - lo).max_element().max(1e-12);
     let (lo, hi) = (lo - DVec2::splat(pad), hi + DVec2::splat(pad));
@@ -276,7 +294,7 @@ fn front_part(q: &Piece, clip_piece: &Piece, stats: &mut Pass1) -> std::result::
     }
     stats.clips += 1;
     let c = clip(&q.region, &Region::from_ring(half))?;
-    Ok(Piece::new(q.source, c.inside, q.near))
+    Ok(q.part(c.inside))
 }
 
 /// A piece's part inside another (one at most: a region, or what is left after the last
@@ -291,7 +309,7 @@ fn cut(q: &Piece, by: &Piece, stats: &mut Pass1) -> std::result::Result<Option<P
     if splits(q, by, stats) {
         let Some(s) = convex_split::split(&q.region.rings[0], &by.region.rings[0]) else { return Ok(None) };
         stats.clips += 1;
-        let piece = |r| Piece::convex(q.source, r, q.near);
+        let piece = |r| q.convex_part(r);
         return Ok(Some((piece(s.inside), s.outside.into_iter().filter_map(piece).collect())));
     }
     stats.clips += 1;
@@ -299,7 +317,7 @@ fn cut(q: &Piece, by: &Piece, stats: &mut Pass1) -> std::result::Result<Option<P
     if c.inside.rings.is_empty() {
         return Ok(None);
     }
-    let piece = |r| Piece::new(q.source, r, q.near);
+    let piece = |r| q.part(r);
     Ok(Some((piece(c.inside), piece(c.outside).into_iter().collect())))
 }
 
@@ -510,6 +528,7 @@ impl Sorting {
         // they are cut ([`cut_all`]).
         let meets = |p: &Piece| {
             p.overlaps(front)
+                && !p.same_sheet(front)
                 && (splits(p, front, stats) || !stats.convex_split || !regions_apart(&p.region, &front.region))
         };
         let cells = self.cells(front.bounds).collect::<smallvec::SmallVec<[usize; 8]>>();
@@ -576,7 +595,7 @@ fn unshadowed(o: Piece, seen: &[Piece], stats: &mut Pass1) -> std::result::Resul
             next.extend(outside);
             // Over the overlap, the caster hides `o` where it is nearer.
             if let Some(overlap) = inside {
-                let caster = Piece { near: s.near, ..overlap.clone() };
+                let caster = Piece { near: s.near, sheet: s.sheet, ..overlap.clone() };
                 match relation(&caster, &overlap) {
                     Relation::Behind => next.push(overlap),
                     Relation::Front => {}
@@ -914,11 +933,17 @@ impl Mapped {
         Some(piece)
     }
 
-    /// The pieces of the polygons that `keep` keeps, casters and others apart, in order.
-    fn pieces(&self, keep: impl Fn(usize) -> bool + Sync) -> (Vec<Piece>, Vec<Piece>) {
+    /// The pieces of the polygons that `keep` keeps, casters and others apart, in order,
+    /// each in its `sheet` (if any).
+    fn pieces(
+        &self,
+        keep: impl Fn(usize) -> bool + Sync,
+        sheet: impl Fn(usize) -> Option<u32> + Sync,
+    ) -> (Vec<Piece>, Vec<Piece>) {
         let of = |casts: bool| {
-            let all = self.polys.par_iter().enumerate();
-            all.filter(|(i, p)| p.casts == casts && keep(*i)).filter_map(|(_, p)| self.piece(p)).collect()
+            let all = self.polys.par_iter().enumerate().filter(|(i, p)| p.casts == casts && keep(*i));
+            let piece = |(i, p)| Some(Piece { sheet: sheet(i).unwrap_or(NO_ITEM), ..self.piece(p)? });
+            all.filter_map(piece).collect()
         };
         (of(true), of(false))
     }
@@ -938,7 +963,7 @@ fn lit_in_view(
     let lone = if stats.lone_sheets { take_lone(scene, &mapped, stats.backgrounds) } else { LoneSplit::default() };
     stats.lone += lone.lone.len() as u64;
     stats.backgrounds_found += lone.behind.len() as u64;
-    let (casters, others) = mapped.pieces(|i| lone.sorted.get(i) != Some(&false));
+    let (casters, others) = mapped.pieces(|i| lone.sorted.get(i) != Some(&false), |i| lone.sheet.get(i).copied());
     drop(mapped);
     // Independent regions of the view (one, for up to TILE_PIECES casters), sorted in
     // parallel.
@@ -1005,6 +1030,9 @@ struct LoneSplit {
     behind: Vec<Piece>,
     /// `sorted[i]`: whether mapped polygon `i` is neither, and goes on to the sort.
     sorted: Vec<bool>,
+    /// `sheet[i]`: mapped polygon `i`'s sheet where it clears itself, or [`NO_ITEM`] (ours:
+    /// the sort passes over pairs of one sheet, which never overlap).
+    sheet: Vec<u32>,
 }
 
 /// Step 1(b), ours, before the sort: the casters no other polygon in the view meets leave
@@ -1056,7 +1084,11 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
     let sorted = pieces::marked(n, kept.par_iter().zip(&found.lone).filter(|(_, &l)| !l).map(|(&i, _)| i));
     let lone = kept.par_iter().zip(&found.lone).filter(|(_, &l)| l).map(|(&i, _)| m.polys[i].source).collect();
     let behind = (0..n).into_par_iter().filter(|&i| behind[i]).filter_map(|i| m.piece(&m.polys[i])).collect();
-    LoneSplit { lone, outlines, behind, sorted }
+    let mut sheet = vec![NO_ITEM; n];
+    for (&i, &s) in kept.iter().zip(&found.sheet) {
+        sheet[i] = s;
+    }
+    LoneSplit { lone, outlines, behind, sorted, sheet }
 }
 
 /// The places among `kept` (indices into `m.polys`) of the sheet polygons (`sheet`), by the
@@ -1249,7 +1281,7 @@ fn into_quarters(pieces: Vec<Piece>, quarters: &[(DVec2, DVec2); 4]) -> [Vec<Pie
             continue;
         }
         for k in hit {
-            out[k].extend(Piece::new(p.source, cut_to(&p.region, quarters[k]), p.near));
+            out[k].extend(p.part(cut_to(&p.region, quarters[k])));
         }
     }
     out
@@ -1357,6 +1389,9 @@ fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> 
         active.retain(|(_, bounds)| bounds.1.x >= a.bounds.0.x);
         for &(k, _) in active.iter().filter(|(_, bounds)| boxes_meet(a.bounds, *bounds)) {
             let b = &casters[k];
+            if a.same_sheet(b) {
+                continue;
+            }
             // Whether the pair would clear either flag, asked (once their boxes meet) before
             // the dearer question whether their insides meet at all.
             let clears_i = back[i] && !matches!(relation(b, a), Relation::Front);
@@ -1386,7 +1421,10 @@ fn behind_all(
     let within =
         |s: &Piece| b.convex && convex_split::holds(&b.region.rings[0], s.region.rings.iter().flatten().copied());
     // The visible pieces whose boxes meet `b`'s.
-    let meeting = || boxes.iter().zip(seen).filter(|(bx, _)| boxes_meet(**bx, b.bounds)).map(|(_, s)| s);
+    let meeting = || {
+        let met = boxes.iter().zip(seen).filter(|(bx, _)| boxes_meet(**bx, b.bounds));
+        met.map(|(_, s)| s).filter(|s| !s.same_sheet(&b))
+    };
     let mut holes = Vec::new();
     for s in meeting() {
         if within(s) {
