@@ -1357,10 +1357,10 @@ fn lit_pieces(
         pieces.extend(unshadowed(o, &seen, stats)?);
     }
     stats.backgrounds_found += backs.len() as u64;
-    let boxes: Vec<(DVec2, DVec2)> =
-        if backs.is_empty() { Vec::new() } else { seen.iter().map(|p| p.bounds).collect() };
+    let boxes = if backs.is_empty() { SeenBoxes::default() } else { SeenBoxes::new(&seen) };
+    let mut near = Vec::new();
     for b in backs {
-        let lit = behind_all(b, &seen, &boxes, stats)?;
+        let lit = behind_all(b, &seen, &boxes, &mut near, stats)?;
         if let Some(c) = cover.as_deref_mut() {
             c.extend(lit.iter().cloned());
         }
@@ -1409,22 +1409,21 @@ fn backgrounds(casters: &[Piece], split: &impl Fn(&Piece) -> bool) -> Vec<bool> 
 /// The lit part of `b`, a polygon behind everything it overlaps: where no visible piece of
 /// `seen` covers it. The visible pieces do not overlap one another, so when all those over
 /// `b` lie inside it they become holes in it, as they are, by the even-odd rule (ours: no
-/// clip); otherwise `b` is cut by each. `boxes[i]` is `seen[i]`'s box (ours: the pieces are
-/// read only where their boxes meet `b`'s).
+/// clip); otherwise `b` is cut by each. `boxes` holds `seen`'s boxes (ours: the pieces are
+/// read only where their boxes meet `b`'s); `near` is room for their indices.
 fn behind_all(
     b: Piece,
     seen: &[Piece],
-    boxes: &[(DVec2, DVec2)],
+    boxes: &SeenBoxes,
+    near: &mut Vec<u32>,
     stats: &mut Pass1,
 ) -> std::result::Result<Vec<Piece>, ClipError> {
     // A piece inside `b` meets it; one that is not is asked whether it is apart.
     let within =
         |s: &Piece| b.convex && convex_split::holds(&b.region.rings[0], s.region.rings.iter().flatten().copied());
-    // The visible pieces whose boxes meet `b`'s.
-    let meeting = || {
-        let met = boxes.iter().zip(seen).filter(|(bx, _)| boxes_meet(**bx, b.bounds));
-        met.map(|(_, s)| s).filter(|s| !s.same_sheet(&b))
-    };
+    // The visible pieces whose boxes meet `b`'s, in order.
+    boxes.meeting(b.bounds, near);
+    let meeting = || near.iter().map(|&i| &seen[i as usize]).filter(|s| !s.same_sheet(&b));
     let mut holes = Vec::new();
     for s in meeting() {
         if within(s) {
@@ -1435,6 +1434,47 @@ fn behind_all(
         }
     }
     Ok(holed(b, &holes).into_iter().collect())
+}
+
+/// The boxes of a region's visible pieces in a uniform grid (ours): each background behind
+/// them reads only the pieces whose boxes share a cell with its box, not every piece.
+#[derive(Default)]
+struct SeenBoxes {
+    boxes: Vec<(DVec2, DVec2)>,
+    /// Per cell, the pieces whose boxes meet it, in increasing order.
+    cells: Vec<Vec<u32>>,
+    lo: DVec2,
+    size: DVec2,
+    g: usize,
+}
+
+impl SeenBoxes {
+    fn new(seen: &[Piece]) -> SeenBoxes {
+        let boxes: Vec<(DVec2, DVec2)> = seen.iter().map(|p| p.bounds).collect();
+        let Some((lo, hi)) = boxes.iter().copied().reduce(box_union) else { return SeenBoxes::default() };
+        let g = ((boxes.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
+        let size = (hi - lo).max(DVec2::splat(1e-300));
+        let mut cells = vec![Vec::new(); g * g];
+        for (i, &b) in boxes.iter().enumerate() {
+            for (c, r) in grid_cells(lo, size, (g, g), b) {
+                cells[c * g + r].push(i as u32);
+            }
+        }
+        SeenBoxes { boxes, cells, lo, size, g }
+    }
+
+    /// The pieces whose boxes meet `b`, into `out`, in increasing order.
+    fn meeting(&self, b: (DVec2, DVec2), out: &mut Vec<u32>) {
+        out.clear();
+        if self.boxes.is_empty() {
+            return;
+        }
+        for (c, r) in grid_cells(self.lo, self.size, (self.g, self.g), b) {
+            out.extend(self.cells[c * self.g + r].iter().filter(|&&i| boxes_meet(self.boxes[i as usize], b)));
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
 }
 
 /// Pass 1 and the merge for light `light` of `scene` ([`ShadowDatabase::build`]): every
