@@ -17,7 +17,7 @@
 //! rings whose even-odd inside is exactly that union.
 
 use super::weiler_atherton::signed_area;
-use super::{edge_loops, grid_cells, grid_rectangle, simple};
+use super::{edge_loops, grid_rectangle, simple};
 use glam::DVec2;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
@@ -73,7 +73,7 @@ pub(crate) fn find(items: &[Item]) -> Lone {
     // The grid: each cell holds the one owner whose boxes meet it, or CONFLICT.
     let owner = |i: usize| if in_valid(i) { root[i] } else { (n + i) as u32 };
     let Some(grid) = Grid::new(items, owner) else { return lone };
-    lone.lone = (0..n).into_par_iter().map(|i| in_valid(i) && grid.only(items[i].bounds, root[i])).collect();
+    lone.lone = (0..n).into_par_iter().map(|i| in_valid(i) && grid.only(i, root[i])).collect();
     lone.outlines = members
         .par_iter()
         .filter_map(|(_, m)| {
@@ -250,8 +250,8 @@ fn chain_all(edges: &[(DVec2, DVec2)]) -> Vec<Vec<DVec2>> {
 struct Grid {
     /// Each cell's mark, as all threads left it.
     cells: Vec<AtomicU32>,
-    lo: DVec2,
-    size: DVec2,
+    /// Each item's cells: its first and last column, first and last row.
+    rects: Vec<[u16; 4]>,
     /// Columns and rows.
     g: (usize, usize),
 }
@@ -278,38 +278,42 @@ impl Grid {
         let cell = median.max((size.x * size.y / most).sqrt()).max(1e-300);
         let count = |w: f64| ((w / cell).ceil() as usize).clamp(1, 4096);
         let g = (count(size.x), count(size.y));
-        let marks: usize = items
+        // Each item's cells, found once for the marks and the reads (at most 4,096 a side).
+        let rects: Vec<[u16; 4]> = items
             .par_iter()
             .map(|item| {
                 let (c0, c1, r0, r1) = grid_rectangle(lo, size, g, item.bounds);
-                (c1 + 1 - c0) * (r1 + 1 - r0)
+                [c0, c1, r0, r1].map(|v| v as u16)
             })
-            .sum();
+            .collect();
+        let marks: usize =
+            rects.par_iter().map(|&[c0, c1, r0, r1]| usize::from(c1 + 1 - c0) * usize::from(r1 + 1 - r0)).sum();
         if marks > MARKS_PER_ITEM * items.len() + 1024 {
             return None;
         }
         // Marked by all threads: a cell's mark is the same whatever order its owners come in
         // (one owner, or CONFLICT), so each is merged into its cell atomically.
         let cells: Vec<AtomicU32> = (0..g.0 * g.1).into_par_iter().map(|_| AtomicU32::new(EMPTY)).collect();
-        items.par_iter().enumerate().for_each(|(i, item)| {
+        rects.par_iter().enumerate().for_each(|(i, &rect)| {
             let o = owner(i);
             let merge = |cell: u32| (cell != o && cell != CONFLICT).then_some(if cell == EMPTY { o } else { CONFLICT });
             // Nested loops over the rectangle: an iterator of iterators asks at every step
             // which one it is in.
-            let (c0, c1, r0, r1) = grid_rectangle(lo, size, g, item.bounds);
+            let [c0, c1, r0, r1] = rect.map(usize::from);
             for column in cells[c0 * g.1..(c1 + 1) * g.1].chunks(g.1) {
                 for cell in &column[r0..=r1] {
                     let _ = cell.fetch_update(Ordering::Relaxed, Ordering::Relaxed, merge);
                 }
             }
         });
-        Some(Grid { cells, lo, size, g })
+        Some(Grid { cells, rects, g })
     }
 
-    /// Whether every cell `bounds` meets is held by `owner` alone.
-    fn only(&self, bounds: (DVec2, DVec2), owner: u32) -> bool {
-        let mark = |c: usize, r: usize| self.cells[c * self.g.1 + r].load(Ordering::Relaxed);
-        grid_cells(self.lo, self.size, self.g, bounds).all(|(c, r)| mark(c, r) == owner)
+    /// Whether every cell item `i` meets is held by `owner` alone.
+    fn only(&self, i: usize, owner: u32) -> bool {
+        let [c0, c1, r0, r1] = self.rects[i].map(usize::from);
+        let column = |c: usize| &self.cells[c * self.g.1 + r0..=c * self.g.1 + r1];
+        (c0..=c1).all(|c| column(c).iter().all(|cell| cell.load(Ordering::Relaxed) == owner))
     }
 }
 

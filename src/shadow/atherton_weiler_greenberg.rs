@@ -250,15 +250,19 @@ fn relation(q: &Piece, clip: &Piece) -> Relation {
 
 /// How a polygon with corners `points` and nearness `near` lies relative to another's
 /// plane `clip` over the polygon's own area.
-fn relation_at(points: impl Iterator<Item = DVec2> + Clone, near: &DepthPlane, clip: &DepthPlane) -> Relation {
-    let (mut front, mut behind) = (false, false);
-    let scale = points.clone().map(|p| clip.inv_z(p.x, p.y).abs()).fold(0.0, f64::max).max(1e-300);
-    let tol = 1e-9 * scale;
+fn relation_at(points: impl Iterator<Item = DVec2>, near: &DepthPlane, clip: &DepthPlane) -> Relation {
+    // One pass: the nearness differences' least and greatest, and the scale of `clip`'s
+    // nearness, measured against a tolerance of that scale.
+    let (mut scale, mut least, mut most) = (0.0f64, f64::INFINITY, f64::NEG_INFINITY);
     for p in points {
-        let d = near.inv_z(p.x, p.y) - clip.inv_z(p.x, p.y);
-        front |= d > tol;
-        behind |= d < -tol;
+        let c = clip.inv_z(p.x, p.y);
+        let d = near.inv_z(p.x, p.y) - c;
+        scale = scale.max(c.abs());
+        least = least.min(d);
+        most = most.max(d);
     }
+    let tol = 1e-9 * scale.max(1e-300);
+    let (front, behind) = (most > tol, least < -tol);
     match (front, behind) {
         (true, true) => Relation::Mixed,
         (true, false) => Relation::Front,
