@@ -384,7 +384,7 @@ fn visible(list: Vec<Piece>, depth: u64, stats: &mut Pass1) -> std::result::Resu
         }
         // Resolve what is in front first, then keep the front polygon where none of it is.
         let seen = visible(fronts, depth + 1, stats)?;
-        let remains = outside_all(front, &seen, stats)?;
+        let remains = outside_all(front, seen.iter(), stats)?;
         out.extend(seen);
         out.extend(remains);
     }
@@ -455,7 +455,11 @@ fn cut_all(
 }
 
 /// What is left of `piece` outside every piece of `by`.
-fn outside_all(piece: Piece, by: &[Piece], stats: &mut Pass1) -> std::result::Result<Vec<Piece>, ClipError> {
+fn outside_all<'a>(
+    piece: Piece,
+    by: impl IntoIterator<Item = &'a Piece>,
+    stats: &mut Pass1,
+) -> std::result::Result<Vec<Piece>, ClipError> {
     let mut remains = vec![piece];
     for s in by {
         let mut next = Vec::with_capacity(remains.len());
@@ -1433,8 +1437,8 @@ fn behind_all(
         if within(s) {
             holes.push(s);
         } else if !regions_apart(&s.region, &b.region) {
-            let over: Vec<Piece> = meeting().filter(|s| !regions_apart(&s.region, &b.region)).cloned().collect();
-            return outside_all(b, &over, stats);
+            let over: Vec<&Piece> = meeting().filter(|s| !regions_apart(&s.region, &b.region)).collect();
+            return outside_all(b, over, stats);
         }
     }
     Ok(holed(b, &holes).into_iter().collect())
