@@ -971,7 +971,8 @@ fn lit_in_view(
     let lone = if stats.lone_sheets { take_lone(scene, &mapped, stats.backgrounds) } else { LoneSplit::default() };
     stats.lone += lone.lone.len() as u64;
     stats.backgrounds_found += lone.behind.len() as u64;
-    let (casters, others) = mapped.pieces(|i| lone.sorted.get(i) != Some(&false), |i| lone.sheet.get(i).copied());
+    let sheet = |i: usize| lone.sheet.binary_search_by_key(&(i as u32), |&(j, _)| j).ok().map(|k| lone.sheet[k].1);
+    let (casters, others) = mapped.pieces(|i| lone.sorted.get(i) != Some(&false), sheet);
     drop(mapped);
     // Independent regions of the view (one, for up to TILE_PIECES casters), sorted in
     // parallel.
@@ -1038,9 +1039,10 @@ struct LoneSplit {
     behind: Vec<Piece>,
     /// `sorted[i]`: whether mapped polygon `i` is neither, and goes on to the sort.
     sorted: Vec<bool>,
-    /// `sheet[i]`: mapped polygon `i`'s sheet where it clears itself, or [`NO_ITEM`] (ours:
-    /// the sort passes over pairs of one sheet, which never overlap).
-    sheet: Vec<u32>,
+    /// The polygons that go on to the sort on a sheet that clears itself, as (mapped
+    /// polygon, its sheet), in increasing order (ours: the sort passes over pairs of one
+    /// sheet, which never overlap).
+    sheet: Vec<(u32, u32)>,
 }
 
 /// Step 1(b), ours, before the sort: the casters no other polygon in the view meets leave
@@ -1092,10 +1094,8 @@ fn take_lone(scene: &Scene, m: &Mapped, backgrounds: bool) -> LoneSplit {
     let sorted = pieces::marked(n, kept.par_iter().zip(&found.lone).filter(|(_, &l)| !l).map(|(&i, _)| i));
     let lone = kept.par_iter().zip(&found.lone).filter(|(_, &l)| l).map(|(&i, _)| m.polys[i].source).collect();
     let behind = (0..n).into_par_iter().filter(|&i| behind[i]).filter_map(|i| m.piece(&m.polys[i])).collect();
-    let mut sheet = vec![NO_ITEM; n];
-    for (&i, &s) in kept.iter().zip(&found.sheet) {
-        sheet[i] = s;
-    }
+    let on_sheet = kept.par_iter().zip(&found.sheet).zip(&found.lone).filter(|((_, &s), &l)| s != NO_ITEM && !l);
+    let sheet = on_sheet.map(|((&i, &s), _)| (i as u32, s)).collect();
     LoneSplit { lone, outlines, behind, sorted, sheet }
 }
 
