@@ -483,44 +483,61 @@ struct Sorting {
     arena: Vec<Option<Piece>>,
     keys: Vec<OrdF64>,
     heap: std::collections::BinaryHeap<(OrdF64, std::cmp::Reverse<u32>)>,
-    grid: Vec<Vec<u32>>,
+    grid: BoxGrid,
     /// `stamp[q]`: the last front polygon piece `q` was found for.
     stamp: Vec<u32>,
+}
+
+/// A uniform grid over boxes, about one cell per box: each cell lists, by index, the boxes
+/// added that meet it, in the order they were added.
+#[derive(Default)]
+struct BoxGrid {
+    cells: Vec<Vec<u32>>,
     lo: DVec2,
     size: DVec2,
     g: usize,
 }
 
-impl Sorting {
-    /// An empty sort over the bounds of `list` (`None` when `list` is empty).
-    fn new(list: &[Piece]) -> Option<Sorting> {
-        let (lo, hi) = list.iter().map(|p| p.bounds).reduce(box_union)?;
-        let g = ((list.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
+impl BoxGrid {
+    /// An empty grid over `bounds` (least, greatest corner) for `n` boxes.
+    fn new((lo, hi): (DVec2, DVec2), n: usize) -> BoxGrid {
+        let g = ((n as f64).sqrt().ceil() as usize).clamp(1, 256);
         let size = (hi - lo).max(DVec2::splat(1e-300));
-        let n = list.len();
-        Some(Sorting {
-            arena: Vec::with_capacity(n),
-            keys: Vec::with_capacity(n),
-            heap: std::collections::BinaryHeap::with_capacity(n),
-            grid: vec![Vec::new(); g * g],
-            stamp: Vec::with_capacity(n),
-            lo,
-            size,
-            g,
-        })
+        BoxGrid { cells: vec![Vec::new(); g * g], lo, size, g }
     }
 
+    /// The cells box `b` meets (the grid made by [`BoxGrid::new`]).
     fn cells(&self, b: (DVec2, DVec2)) -> impl Iterator<Item = usize> {
         let g = self.g;
         grid_cells(self.lo, self.size, (g, g), b).map(move |(c, r)| c * g + r)
     }
 
+    /// Adds box `i`, `b`, to the cells it meets.
+    fn add(&mut self, i: u32, b: (DVec2, DVec2)) {
+        for c in self.cells(b).collect::<smallvec::SmallVec<[usize; 8]>>() {
+            self.cells[c].push(i);
+        }
+    }
+}
+
+impl Sorting {
+    /// An empty sort over the bounds of `list` (`None` when `list` is empty).
+    fn new(list: &[Piece]) -> Option<Sorting> {
+        let bounds = list.iter().map(|p| p.bounds).reduce(box_union)?;
+        let n = list.len();
+        Some(Sorting {
+            arena: Vec::with_capacity(n),
+            keys: Vec::with_capacity(n),
+            heap: std::collections::BinaryHeap::with_capacity(n),
+            grid: BoxGrid::new(bounds, n),
+            stamp: Vec::with_capacity(n),
+        })
+    }
+
     /// Adds `p` with sort key `key` (nearest first, then first added).
     fn add(&mut self, p: Piece, key: OrdF64) {
         let i = self.arena.len() as u32;
-        for c in self.cells(p.bounds).collect::<smallvec::SmallVec<[usize; 8]>>() {
-            self.grid[c].push(i);
-        }
+        self.grid.add(i, p.bounds);
         self.heap.push((key, std::cmp::Reverse(i)));
         self.keys.push(key);
         self.stamp.push(u32::MAX);
@@ -539,8 +556,8 @@ impl Sorting {
                 && !p.same_sheet(front)
                 && (splits(p, front, stats) || !stats.convex_split || !regions_apart(&p.region, &front.region))
         };
-        let cells = self.cells(front.bounds).collect::<smallvec::SmallVec<[usize; 8]>>();
-        if !stats.sort_grid || cells.len() * 4 >= self.grid.len() {
+        let cells = self.grid.cells(front.bounds).collect::<smallvec::SmallVec<[usize; 8]>>();
+        if !stats.sort_grid || cells.len() * 4 >= self.grid.cells.len() {
             // A front polygon over much of the grid (a stack of large polygons): the pieces
             // are fewer to read than the cells' lists.
             let live = self.arena.iter().enumerate().filter_map(|(q, p)| Some((q as u32, p.as_ref()?)));
@@ -550,7 +567,7 @@ impl Sorting {
         for c in cells {
             // Pieces taken since (hidden, or sorted) leave the cell as it is read.
             let (arena, stamp) = (&self.arena, &mut self.stamp);
-            self.grid[c].retain(|&q| {
+            self.grid.cells[c].retain(|&q| {
                 let Some(p) = &arena[q as usize] else { return false };
                 if stamp[q as usize] != fi {
                     stamp[q as usize] = fi;
@@ -1449,26 +1466,18 @@ fn behind_all(
 #[derive(Default)]
 struct SeenBoxes {
     boxes: Vec<(DVec2, DVec2)>,
-    /// Per cell, the pieces whose boxes meet it, in increasing order.
-    cells: Vec<Vec<u32>>,
-    lo: DVec2,
-    size: DVec2,
-    g: usize,
+    grid: BoxGrid,
 }
 
 impl SeenBoxes {
     fn new(seen: &[Piece]) -> SeenBoxes {
         let boxes: Vec<(DVec2, DVec2)> = seen.iter().map(|p| p.bounds).collect();
-        let Some((lo, hi)) = boxes.iter().copied().reduce(box_union) else { return SeenBoxes::default() };
-        let g = ((boxes.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
-        let size = (hi - lo).max(DVec2::splat(1e-300));
-        let mut cells = vec![Vec::new(); g * g];
+        let Some(bounds) = boxes.iter().copied().reduce(box_union) else { return SeenBoxes::default() };
+        let mut grid = BoxGrid::new(bounds, boxes.len());
         for (i, &b) in boxes.iter().enumerate() {
-            for (c, r) in grid_cells(lo, size, (g, g), b) {
-                cells[c * g + r].push(i as u32);
-            }
+            grid.add(i as u32, b);
         }
-        SeenBoxes { boxes, cells, lo, size, g }
+        SeenBoxes { boxes, grid }
     }
 
     /// The pieces whose boxes meet `b`, into `out`, in increasing order.
@@ -1477,8 +1486,8 @@ impl SeenBoxes {
         if self.boxes.is_empty() {
             return;
         }
-        for (c, r) in grid_cells(self.lo, self.size, (self.g, self.g), b) {
-            out.extend(self.cells[c * self.g + r].iter().filter(|&&i| boxes_meet(self.boxes[i as usize], b)));
+        for c in self.grid.cells(b) {
+            out.extend(self.grid.cells[c].iter().filter(|&&i| boxes_meet(self.boxes[i as usize], b)));
         }
         out.sort_unstable();
         out.dedup();
