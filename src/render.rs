@@ -541,6 +541,7 @@ fn shade_band(ctx: &ShadowContext, shadows: &dyn crate::shadow::ShadowStage, sha
     }
     walker.finish(&mut shadow);
     shadow.add(crate::stats::Counter::SelfShadowedRuns, self_shadowed);
+    shadow.add(crate::stats::Counter::DarkRuns, line_shading.dark_runs());
     (shadow, walking, shading)
 }
 

@@ -255,6 +255,9 @@ counters! {
     /// Every stage: runs the same-side rule settled before the stage was asked (the light
     /// behind the seen side).
     SelfShadowedRuns = "self_shadowed_runs",
+    /// Every stage: runs no light reaches at any pixel (in shadow, or turned from every
+    /// light), shaded as their ambient term alone (ours).
+    DarkRuns = "dark_runs",
     /// Every stage, area lights: pixels in the umbra (seed 000's, of the grid or exact).
     UmbraPixels = "umbra_pixels",
     /// Every stage, area lights: pixels in the penumbra.

@@ -179,11 +179,25 @@ pub(crate) struct LineShading {
     /// then wait on memory together, not one run after another (a line of s3 meets some
     /// five hundred triangles, most of them for the first time).
     triangles: Vec<[DVec3; 6]>,
+    /// Whether each run is dark ([`Shader::dark`]), made with `triangles` (a dark run's
+    /// triangle is not made).
+    dark: Vec<bool>,
     /// Every run on the f64 path (the tests compare the two paths with it).
     f64_only: bool,
-    /// Gouraud and Phong runs shaded in lanes and in f64.
+    /// Dark runs lit like the others (the tests compare the two with it).
+    light_dark_runs: bool,
+    /// Gouraud and Phong runs shaded in lanes and in f64, and dark runs left at their
+    /// ambient term.
     runs_in_lanes: u64,
     runs_in_f64: u64,
+    runs_dark: u64,
+}
+
+impl LineShading {
+    /// The runs shaded so far that no light reached ([`Shader::dark`]).
+    pub(crate) fn dark_runs(&self) -> u64 {
+        self.runs_dark
+    }
 }
 
 /// Per-run scratch: what one run needs whatever the light (reused from run to run).
@@ -317,12 +331,21 @@ impl<'a> Shader<'a> {
         rs.ray_row = self.view.ray(0.5, rs.yc);
         rs.step = self.view.ray_step();
         ls.triangles.clear();
-        ls.triangles.extend(runs.iter().map(|run| self.triangle(run.poly as usize)));
-        for (run, triangle) in runs.iter().zip(&ls.triangles) {
+        ls.dark.clear();
+        for run in runs {
+            let dark = !ls.light_dark_runs && self.dark(run, lit, width);
+            ls.dark.push(dark);
+            ls.triangles.push(if dark { [DVec3::ZERO; 6] } else { self.triangle(run.poly as usize) });
+        }
+        for ((run, triangle), &dark) in runs.iter().zip(&ls.triangles).zip(&ls.dark) {
             let (x0, x1) = (run.x0 as usize, run.x1 as usize);
             let lit = |k: usize| &lit[k * width + x0..k * width + x1];
             self.begin_run(run, rs);
             ls.lanes.start_run(x0, x1, self.ambient(rs.poly));
+            if dark {
+                ls.runs_dark += 1;
+                continue;
+            }
             let in_lanes = match self.scene.material(rs.poly).shading {
                 ShadingMode::Flat => {
                     self.flat_run(rs, &mut ls.lanes, lit);
@@ -335,6 +358,17 @@ impl<'a> Shader<'a> {
         }
         ls.lanes.shade_phong(&self.lane_lights, &self.lane_materials, lit);
         ls.lanes.finish(out);
+    }
+
+    /// Whether no light reaches any pixel of `run` (ours): every term's lit values there,
+    /// and an area light's irradiance vectors, are zero. Each term's light is weighted by
+    /// them, and a zero weight adds nothing (both paths pass over it), so the run is its
+    /// ambient term alone, and is not lit at all: a run in shadow, or turned from every
+    /// light, costs its ambient term.
+    fn dark(&self, run: &Run, lit: &[f32], width: usize) -> bool {
+        let zero =
+            |row: usize| lit[row * width + run.x0 as usize..row * width + run.x1 as usize].iter().all(|&v| v == 0.0);
+        self.terms.iter().all(|t| zero(t.row) && t.vector.is_none_or(|v| (v..v + 3).all(zero)))
     }
 
     /// Readies `rs` for `run`, on the line `rs` was readied for.
@@ -785,6 +819,59 @@ mod tests {
         assert!(triangle_runs > 500, "{triangle_runs} runs on triangles");
         assert!(lambert_lights > 5, "{lambert_lights} area lights lit by irradiance vectors");
         eprintln!("worst difference {worst:e} over {in_lanes} runs in lanes, {triangle_runs} on triangles");
+    }
+
+    /// A dark run (no light reaches any of its pixels) comes out its ambient term alone,
+    /// the same to the bit as when it is lit like the others: on random scenes in every
+    /// shading mode and specular model, in lanes and in f64, with area lights' irradiance
+    /// vectors on every other scene, and every other run dark.
+    #[test]
+    fn dark_runs_are_their_ambient_term_to_the_bit() {
+        use crate::generate::{random, RandomOptions};
+        use crate::visibility::{resolve_frame, VisibilityMethod};
+        let (mut dark, mut lit_runs) = (0, 0);
+        for seed in 0..24u64 {
+            let mut scene = random(seed, RandomOptions { polygons: 8, width: 80, height: 60 }).unwrap();
+            let mut materials = scene.materials().to_vec();
+            for (i, m) in materials.iter_mut().enumerate() {
+                let k = seed as usize + i;
+                m.shading = [ShadingMode::Phong, ShadingMode::Gouraud, ShadingMode::Flat][k % 3];
+                m.model = [SpecularModel::Phong, SpecularModel::Blinn, SpecularModel::CookTorrance][k % 3];
+            }
+            scene.set_materials(materials).unwrap();
+            let view = View::new(&scene.camera);
+            let samples: Vec<_> = scene.lights.iter().map(Light::samples).collect();
+            let count: usize = samples.iter().map(Vec::len).sum();
+            let vector =
+                |(l, light): (usize, &Light)| (seed % 2 == 0 && area_centre(light).is_some()).then_some(count + 3 * l);
+            let shader =
+                Shader::with_irradiance(&scene, &view, &samples, scene.lights.iter().enumerate().map(vector).collect());
+            let (runs, _) = resolve_frame(&scene, VisibilityMethod::Scanline);
+            let (width, rows) = (view.width as usize, count + 3 * samples.len());
+            for f64_only in [false, true] {
+                let mut skipping = LineShading { f64_only, ..Default::default() };
+                let mut lighting = LineShading { f64_only, light_dark_runs: true, ..Default::default() };
+                for (y, line) in runs.lines.iter().enumerate() {
+                    // Every other run dark in every row; the others lit in a pattern.
+                    let mut lit = vec![0.0f32; rows * width];
+                    for (k, run) in line.iter().enumerate().filter(|(k, _)| (k + y) % 2 == 0) {
+                        for row in 0..rows {
+                            for x in run.x0 as usize..run.x1 as usize {
+                                lit[row * width + x] = [1.0, 0.5, 0.0, 0.25][(x + row + k) % 4];
+                            }
+                        }
+                    }
+                    let (mut a, mut b) = (vec![Vec3::ZERO; width], vec![Vec3::ZERO; width]);
+                    shader.shade_line(&mut skipping, y as u32, line, &lit, &mut a);
+                    shader.shade_line(&mut lighting, y as u32, line, &lit, &mut b);
+                    assert_eq!(a, b, "seed {seed}, line {y}, f64 only: {f64_only}");
+                }
+                assert_eq!(lighting.runs_dark, 0);
+                (dark, lit_runs) =
+                    (dark + skipping.runs_dark, lit_runs + skipping.runs_in_lanes + skipping.runs_in_f64);
+            }
+        }
+        assert!(dark > 1000 && lit_runs > 1000, "{dark} dark runs, {lit_runs} lit");
     }
 
     /// Background pixels between runs and after the last are the background colour, and a
