@@ -340,12 +340,12 @@ impl<'a> Shader<'a> {
         for ((run, triangle), &dark) in runs.iter().zip(&ls.triangles).zip(&ls.dark) {
             let (x0, x1) = (run.x0 as usize, run.x1 as usize);
             let lit = |k: usize| &lit[k * width + x0..k * width + x1];
-            self.begin_run(run, rs);
-            ls.lanes.start_run(x0, x1, self.ambient(rs.poly));
+            ls.lanes.start_run(x0, x1, self.ambient(run.poly as usize));
             if dark {
                 ls.runs_dark += 1;
                 continue;
             }
+            self.begin_run(run, rs);
             let in_lanes = match self.scene.material(rs.poly).shading {
                 ShadingMode::Flat => {
                     self.flat_run(rs, &mut ls.lanes, lit);

@@ -506,7 +506,8 @@ impl BoxGrid {
         BoxGrid { cells: vec![Vec::new(); g * g], lo, size, g }
     }
 
-    /// The cells box `b` meets (the grid made by [`BoxGrid::new`]).
+    /// The cells box `b` meets (the grid made by [`BoxGrid::new`]); the iterator holds no
+    /// borrow of the grid.
     fn cells(&self, b: (DVec2, DVec2)) -> impl Iterator<Item = usize> {
         let g = self.g;
         grid_cells(self.lo, self.size, (g, g), b).map(move |(c, r)| c * g + r)
@@ -514,7 +515,7 @@ impl BoxGrid {
 
     /// Adds box `i`, `b`, to the cells it meets.
     fn add(&mut self, i: u32, b: (DVec2, DVec2)) {
-        for c in self.cells(b).collect::<smallvec::SmallVec<[usize; 8]>>() {
+        for c in self.cells(b) {
             self.cells[c].push(i);
         }
     }
