@@ -54,7 +54,7 @@ def render(
     """Renders the scene with a visibility and a shadow stage (paper=True: as published).
     Keyword settings set the stage's options by their names in the engine: prefilter,
     sphere_grid, seen_receivers, drop_behind, wedge, slab, solid_outlines, own_solid, solid_cull,
-    convex_split, backgrounds, lone_sheets, tiling, face_binning, sort_grid, counting
+    convex_split, backgrounds, lone_sheets, whole_solids, tiling, face_binning, sort_grid, counting
     ("zpass", "zfail", "naive-zpass"),
     construction ("merged", "per-polygon", "crow-1977"), sight_cuts, far_outline, front_outline, map_size,
     bias, slope_bias, normal_offset, receiver_plane, cull_front, fit_to_view, hull_cull,

@@ -228,6 +228,9 @@ counters! {
     LightViewBackgrounds = "light_view_backgrounds",
     /// Atherton-Weiler-Greenberg: lone polygons in the light view (overlapping none).
     LightViewLone = "light_view_lone",
+    /// Atherton-Weiler-Greenberg: closed solids whose side facing the light was found lone
+    /// whole, without its polygons being mapped one by one (ours).
+    LightViewWholeSolids = "light_view_whole_solids",
     /// Atherton-Weiler-Greenberg: lit detail polygons.
     DetailPolygons = "detail_polygons",
     /// Atherton-Weiler-Greenberg: their vertices.

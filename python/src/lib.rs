@@ -143,7 +143,7 @@ fn named<T: std::str::FromStr<Err = um::Error>>(v: &Bound<'_, PyAny>) -> PyResul
 }
 
 /// Every keyword setting [`stage_settings`] knows, by name.
-const SETTINGS: [(&str, Setter); 32] = [
+const SETTINGS: [(&str, Setter); 33] = [
     ("prefilter", |s, v| v.extract().map(|x| s.bouknight_kelley.prefilter = x)),
     ("sphere_grid", |s, v| v.extract().map(|x| s.bouknight_kelley.sphere_grid = x)),
     ("seen_receivers", |s, v| v.extract().map(|x| s.bouknight_kelley.seen_receivers = x)),
@@ -162,6 +162,7 @@ const SETTINGS: [(&str, Setter); 32] = [
     ("convex_split", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.convex_split = x)),
     ("backgrounds", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.backgrounds = x)),
     ("lone_sheets", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.lone_sheets = x)),
+    ("whole_solids", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.whole_solids = x)),
     ("tiling", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.tiling = x)),
     ("face_binning", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.face_binning = x)),
     ("sort_grid", |s, v| v.extract().map(|x| s.atherton_weiler_greenberg.sort_grid = x)),

@@ -217,7 +217,7 @@ fn key(p: DVec2) -> [u64; 2] {
 
 /// Directed edges chained into closed rings, each corner left by one edge only; `None` when
 /// a corner is left by two, or an edge leads nowhere.
-fn chain(edges: &[(DVec2, DVec2)]) -> Option<Vec<Vec<DVec2>>> {
+pub(crate) fn chain(edges: &[(DVec2, DVec2)]) -> Option<Vec<Vec<DVec2>>> {
     let ends: Vec<([u64; 2], [u64; 2])> = edges.iter().map(|&(a, b)| (key(a), key(b))).collect();
     let loops = edge_loops(&ends)?;
     Some(loops.into_iter().map(|l| l.into_iter().map(|e| edges[e].0).collect()).collect())

@@ -158,6 +158,12 @@ pub struct AthertonWeilerGreenbergOptions {
     /// another) on a grid, without testing pairs, and are wholly lit. `false` sorts them with
     /// the rest, as the paper does.
     pub lone_sheets: bool,
+    /// With `lone_sheets`, settle a closed solid's whole side facing the light at once where
+    /// it lies in one light view (default true; ours): its outline there is found from the
+    /// edges it turns to the light, and where nothing else meets its box, its polygons are
+    /// wholly lit without being mapped one by one. `false` takes every polygon through the
+    /// lone-sheet step alone.
+    pub whole_solids: bool,
     /// Leave out of each light view the polygons of closed solids that cast shadows and turn
     /// away from the light (default true; ours, the solid cull of
     /// `docs/algorithms/bouknight-kelley.md`): they are unlit and hide nothing the solid's
@@ -185,6 +191,7 @@ impl AthertonWeilerGreenbergOptions {
         convex_split: true,
         backgrounds: true,
         lone_sheets: true,
+        whole_solids: true,
         solid_cull: true,
         tiling: true,
         face_binning: true,
@@ -197,6 +204,7 @@ impl AthertonWeilerGreenbergOptions {
         convex_split: false,
         backgrounds: false,
         lone_sheets: false,
+        whole_solids: false,
         solid_cull: false,
         tiling: false,
         face_binning: false,
@@ -956,6 +964,7 @@ impl ShadowMethod {
                 on.push((!o.convex_split, "--no-convex-split".into()));
                 on.push((!o.backgrounds, "--no-backgrounds".into()));
                 on.push((!o.lone_sheets, "--no-lone-sheets".into()));
+                on.push((o.lone_sheets && !o.whole_solids, "--no-whole-solids".into()));
                 on.push((!o.solid_cull, "--no-solid-cull".into()));
                 on.push((!o.tiling, "--no-tiling".into()));
                 on.push((!o.face_binning, "--no-face-binning".into()));

@@ -572,6 +572,77 @@ fn own_solid_front_sets_keep_what_the_behind_test_keeps() {
     assert!(in_shadow > 48 * 300, "only {in_shadow} pixels in shadow");
 }
 
+/// Atherton-Weiler-Greenberg settles a closed solid's whole side facing the light at once
+/// (`whole_solids`, ours) where its triangles, mapped corner by corner, are outlined by one
+/// simple ring and nothing else but the floor meets its box: on random floors under spheres
+/// (geodesic and UV, dented so that their fronts fold, wound either way, some sunk through
+/// the floor, some close enough to shadow one another), lit by point lights from all round
+/// (inside a solid's bounds too) and directional ones, with face binning and without, the
+/// stage with the step equals ray-cast at every pixel but ties, and equals itself without
+/// it; whole solids are settled on most scenes, and none without the step.
+#[test]
+fn whole_solids_settle_what_their_polygons_would() {
+    use rand::{Rng, SeedableRng};
+    use umbra::generate::{geodesic_sphere, sphere_mesh};
+    use umbra::shadow::AthertonWeilerGreenbergOptions;
+    use umbra::{Camera, Counter, Light, Material, Mesh, Object};
+    let (mut settled, mut scenes_settled, mut in_shadow) = (0, 0, 0);
+    for seed in 0..32u64 {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(900 + seed);
+        let mut v = |lo: f64, hi: f64| rng.gen_range(lo..hi);
+        let eye = glam::DVec3::new(v(-6.0, 6.0), v(1.0, 8.0), v(-6.0, 6.0));
+        let mut b = Scene::builder(Camera { width: 80, height: 60, near: 0.05, ..Camera::new(eye, glam::DVec3::ZERO) })
+            .material(Material::new("m"));
+        let floor = [(-6.0, -6.0), (-6.0, 6.0), (6.0, 6.0), (6.0, -6.0)].map(|(x, z)| glam::DVec3::new(x, 0.0, z));
+        b = b.object(Object::new(Mesh::from_polygons(&[floor.to_vec()])), "m");
+        let mut centres = Vec::new();
+        for k in 0..4 {
+            let r = v(0.3, 0.9);
+            // Most rest above the floor; some sink through its plane.
+            let c = glam::DVec3::new(v(-2.5, 2.5), r * v(0.6, 2.5), v(-2.5, 2.5));
+            centres.push(c);
+            let mut mesh = if (seed + k) % 2 == 0 { geodesic_sphere(c, r, 2) } else { sphere_mesh(c, r, 300) };
+            if (seed + k) % 3 == 0 {
+                // A cap pushed in: seen from above, the front folds over itself.
+                let top = c.y + 0.3 * r;
+                mesh.positions.iter_mut().filter(|p| p.y > top).for_each(|p| p.y = top - 0.6 * (p.y - top));
+            }
+            if (seed + k) % 5 == 0 {
+                mesh.faces.iter_mut().for_each(|f| f.vertices.reverse());
+            }
+            b = b.object(Object::new(mesh), "m");
+        }
+        let light = match seed % 4 {
+            3 => Light::directional(glam::DVec3::new(v(-1.0, 1.0), -1.0, v(-1.0, 1.0))),
+            // Above a sphere's centre, inside its bounds.
+            2 if seed % 8 == 2 => Light::point(centres[0] + glam::DVec3::new(0.05, 0.3, -0.02)),
+            _ => Light::point(glam::DVec3::new(v(-5.0, 5.0), v(2.0, 9.0), v(-5.0, 5.0))),
+        };
+        let scene = b.light(light).build().unwrap();
+        let face_binning = seed % 5 != 4;
+        let opts = |whole_solids| umbra::RenderOptions {
+            shadows: ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions {
+                whole_solids,
+                face_binning,
+                ..Default::default()
+            }),
+            ..Default::default()
+        };
+        let label = format!("whole solids seed {seed}, face binning {face_binning}");
+        let (on, off) = (umbra::render(&scene, &opts(true)).unwrap(), umbra::render(&scene, &opts(false)).unwrap());
+        let want = reference(&scene);
+        assert_light_agree(&scene, &want, &on.frame, &format!("{label} with the step"));
+        assert_light_agree(&scene, &off.frame, &on.frame, &format!("{label} with the step against without"));
+        let n = on.stats.shadow_counters.get(Counter::LightViewWholeSolids);
+        settled += n;
+        scenes_settled += u32::from(n > 0);
+        in_shadow += shadowed(&want);
+        assert_eq!(off.stats.shadow_counters.get(Counter::LightViewWholeSolids), 0, "{label}");
+    }
+    assert!(scenes_settled >= 16 && settled >= 32, "{scenes_settled} scenes, {settled} whole solids");
+    assert!(in_shadow > 32 * 300, "only {in_shadow} pixels in shadow");
+}
+
 /// Random meshes closed but for one or two holes (a box, prism or sphere with faces left
 /// out), lit and seen from all round, so that some lights and eyes see into a hole: every
 /// exact stage equals ray-cast at every pixel but ties, and the solid cull leaves nothing of

@@ -171,6 +171,11 @@ struct AwgFlags {
     /// lighting them whole.
     #[arg(long)]
     no_lone_sheets: bool,
+    /// Atherton-Weiler-Greenberg: take each polygon of a closed solid through the lone-sheet
+    /// step alone, instead of settling the solid's whole side facing the light at once where
+    /// it lies in one light view.
+    #[arg(long)]
+    no_whole_solids: bool,
     /// Atherton-Weiler-Greenberg: sort each light view whole, as the paper does, instead of
     /// cutting it into regions of at most 1,024 casters sorted apart.
     #[arg(long)]
@@ -192,6 +197,7 @@ impl AwgFlags {
             convex_split: !self.no_convex_split,
             backgrounds: !self.no_backgrounds,
             lone_sheets: !self.no_lone_sheets,
+            whole_solids: !self.no_whole_solids,
             solid_cull,
             tiling: !self.no_tiling,
             face_binning: !self.no_face_binning,
