@@ -224,7 +224,7 @@ pub(crate) fn chain(edges: &[(DVec2, DVec2)]) -> Option<Vec<Vec<DVec2>>> {
 }
 
 /// Directed edges (each corner left as often as it is reached) chained into closed rings.
-fn chain_all(edges: &[(DVec2, DVec2)]) -> Vec<Vec<DVec2>> {
+pub(crate) fn chain_all(edges: &[(DVec2, DVec2)]) -> Vec<Vec<DVec2>> {
     let mut from: FxHashMap<[u64; 2], Vec<usize>> = FxHashMap::default();
     for (e, &(a, _)) in edges.iter().enumerate() {
         from.entry(key(a)).or_default().push(e);

@@ -1131,6 +1131,8 @@ struct SampleSolids<'a> {
 struct WholeSolid {
     /// Its polygons facing the light, in increasing order.
     polygons: Vec<u32>,
+    /// Their corners in the view.
+    corners: Vec<[DVec2; 3]>,
     /// The outline of their union in the view: one simple ring.
     ring: Vec<DVec2>,
     /// The ring's box.
@@ -1187,7 +1189,7 @@ fn whole_solids(scene: &Scene, view: &LightView, v: u8, of: &SampleSolids, exten
 /// fraction of passing each polygon through the lone-sheet step.
 fn whole_solid(scene: &Scene, view: &LightView, v: u8, of: &SampleSolids, s: usize, near: f64) -> Option<WholeSolid> {
     let facing = |i: u32| of.unseen.get(i as usize) == Some(&false);
-    let (mut polygons, mut edges, mut turn) = (Vec::new(), Vec::new(), 0.0);
+    let (mut polygons, mut mapped, mut edges, mut turn) = (Vec::new(), Vec::new(), Vec::new(), 0.0);
     let mut world = (DVec3::INFINITY, DVec3::NEG_INFINITY);
     for &i in &of.members[s] {
         if !scene.casts_shadows(i as usize) {
@@ -1207,6 +1209,7 @@ fn whole_solid(scene: &Scene, view: &LightView, v: u8, of: &SampleSolids, s: usi
         }
         turn = t;
         polygons.push(i);
+        mapped.push(corners);
         world = [a, b, c].iter().fold(world, |(lo, hi), &p| (lo.min(p), hi.max(p)));
         for (k, &q) in scene.across(i as usize).iter().enumerate() {
             if q == crate::scene::NO_POLYGON || !facing(q) {
@@ -1220,7 +1223,20 @@ fn whole_solid(scene: &Scene, view: &LightView, v: u8, of: &SampleSolids, s: usi
         return None;
     }
     let near = view.nearness(&scene.polygons[*polygons.first()? as usize].plane)?;
-    Some(WholeSolid { bounds: ring_bounds(ring)?, ring: ring.clone(), polygons, near, world, sample: of.sample })
+    Some(WholeSolid {
+        bounds: ring_bounds(ring)?,
+        ring: ring.clone(),
+        polygons,
+        corners: mapped,
+        near,
+        world,
+        sample: of.sample,
+    })
+}
+
+/// The box of a triangle's corners.
+fn corner_box(c: &[DVec2; 3]) -> (DVec2, DVec2) {
+    (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
 }
 
 /// The turn of triangle `[a, b, c]`: 1 counter-clockwise, −1 clockwise, 0 where rounding
@@ -1267,9 +1283,9 @@ struct LoneSplit {
 /// which would otherwise meet everything over them.
 ///
 /// The closed solids offered whole (`solids`, [`whole_solids`]; their polygons are not in
-/// `m`) are lone where their boxes meet no other box but the wide backgrounds'
-/// ([`apart`]); the others are mapped into `m` (`view`) and go through the step polygon by
-/// polygon.
+/// `m`) are lone where their boxes meet no other box but the wide backgrounds', and
+/// otherwise lone in the polygons whose boxes meet none ([`settle`]); their other polygons
+/// are mapped into `m` (`view`) and go through the step polygon by polygon.
 fn take_lone(
     scene: &Scene,
     m: &mut Mapped,
@@ -1282,14 +1298,15 @@ fn take_lone(
     } else {
         vec![false; m.polys.len()]
     };
-    let apart = apart(&solids, m, &behind);
-    let (settled, others): (Vec<_>, Vec<_>) = solids.into_iter().zip(apart).partition(|(_, a)| *a);
-    if !others.is_empty() {
-        let polygons: Vec<u32> = others.iter().flat_map(|(w, _)| w.polygons.iter().copied()).collect();
-        m.extend(Mapped::new(scene, &polygons, view, extent));
+    let met = met_by(&solids, m, &behind);
+    let settled: Vec<Settled> =
+        solids.par_iter().zip(met).with_max_len(1).map(|(w, met)| settle(scene, w, &met)).collect();
+    drop(solids);
+    let rest: Vec<u32> = settled.iter().flat_map(|s| s.rest.iter().copied()).collect();
+    if !rest.is_empty() {
+        m.extend(Mapped::new(scene, &rest, view, extent));
         behind.resize(m.polys.len(), false);
     }
-    let settled: Vec<WholeSolid> = settled.into_iter().map(|(w, _)| w).collect();
     let m = &*m;
     let n = m.polys.len();
     let kept: Vec<usize> = (0..n).into_par_iter().filter(|&i| !behind[i]).collect();
@@ -1318,7 +1335,7 @@ fn take_lone(
     let found = lone_sheets::find(&items);
     // Without lone polygons, wide backgrounds gain nothing from leaving before the cut: they
     // stay, to be found region by region.
-    if settled.is_empty() && !found.lone.contains(&true) {
+    if settled.iter().all(|s| s.lone.is_empty()) && !found.lone.contains(&true) {
         return LoneSplit::default();
     }
     let outlines = found
@@ -1328,44 +1345,106 @@ fn take_lone(
             let p = &m.polys[kept[one as usize]];
             Piece::new(p.source, Region { rings: rings.into() }, p.near)
         })
-        .chain(settled.iter().filter_map(|w| Piece::new(w.polygons[0], Region::from_ring(w.ring.clone()), w.near)))
+        .chain(
+            settled
+                .iter()
+                .filter_map(|s| Piece::new(*s.lone.first()?, Region { rings: s.outline.clone().into() }, s.near)),
+        )
         .collect();
     // What goes on to the sort: the kept polygons (all but the wide backgrounds) not lone.
     let sorted = pieces::marked(n, kept.par_iter().zip(&found.lone).filter(|(_, &l)| !l).map(|(&i, _)| i));
     let mut lone: Vec<u32> =
         kept.par_iter().zip(&found.lone).filter(|(_, &l)| l).map(|(&i, _)| m.polys[i].source).collect();
-    lone.extend(settled.iter().flat_map(|w| w.polygons.iter().copied()));
+    lone.extend(settled.iter().flat_map(|s| s.lone.iter().copied()));
     let behind = (0..n).into_par_iter().filter(|&i| behind[i]).filter_map(|i| m.piece(&m.polys[i])).collect();
     let on_sheet = kept.par_iter().zip(&found.sheet).zip(&found.lone).filter(|((_, &s), &l)| s != NO_ITEM && !l);
     let sheet = on_sheet.map(|((&i, &s), _)| (i as u32, s)).collect();
-    LoneSplit { lone, outlines, behind, sorted, sheet, whole_solids: settled.len() as u64 }
+    let whole_solids = settled.iter().filter(|s| s.rest.is_empty()).count() as u64;
+    LoneSplit { lone, outlines, behind, sorted, sheet, whole_solids }
 }
 
-/// `apart[k]`: whether the box of offered solid `k` meets no other solid's box and no box of
-/// a polygon of `m` that is not a wide background (`behind`): then nothing but those
-/// backgrounds meets its polygons, which no polygon of its own overlaps ([`whole_solid`]).
-fn apart(solids: &[WholeSolid], m: &Mapped, behind: &[bool]) -> Vec<bool> {
-    use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
+/// What of an offered solid is lone ([`settle`]).
+struct Settled {
+    /// Its lone polygons, and the rings of their union's boundary (even-odd).
+    lone: Vec<u32>,
+    outline: Vec<Vec<DVec2>>,
+    /// The solid's nearness (for the outline's piece).
+    near: DepthPlane,
+    /// Its other polygons, to be mapped.
+    rest: Vec<u32>,
+}
+
+/// What of solid `w` is lone, given `met`, the boxes of everything else in the view that
+/// meets its box but the wide backgrounds ([`met_by`]): with none, all of it, its ring the
+/// outline; otherwise the polygons whose own boxes meet none of them (nothing else meets
+/// them, and no polygon of the solid overlaps them: [`whole_solid`]), outlined by their
+/// edges with no lone polygon across.
+fn settle(scene: &Scene, w: &WholeSolid, met: &[(DVec2, DVec2)]) -> Settled {
+    let near = w.near;
+    if met.is_empty() {
+        return Settled { lone: w.polygons.clone(), outline: vec![w.ring.clone()], near, rest: Vec::new() };
+    }
+    let mut grid = BoxGrid::new(w.bounds, met.len());
+    for (k, &b) in met.iter().enumerate() {
+        grid.add(k as u32, b);
+    }
+    let clear =
+        |b: (DVec2, DVec2)| grid.cells(b).all(|c| grid.cells[c].iter().all(|&k| !boxes_meet(b, met[k as usize])));
+    let lone: Vec<bool> = w.corners.iter().map(|c| clear(corner_box(c))).collect();
+    let (mut kept, mut rest, mut edges) = (Vec::new(), Vec::new(), Vec::new());
+    let lone_at = |q: u32| w.polygons.binary_search(&q).is_ok_and(|j| lone[j]);
+    for (j, &i) in w.polygons.iter().enumerate() {
+        if !lone[j] {
+            rest.push(i);
+            continue;
+        }
+        kept.push(i);
+        let c = &w.corners[j];
+        for (k, &q) in scene.across(i as usize).iter().enumerate() {
+            if !lone_at(q) {
+                edges.push((c[k], c[(k + 1) % 3]));
+            }
+        }
+    }
+    Settled { lone: kept, outline: lone_sheets::chain_all(&edges), near, rest }
+}
+
+/// For each offered solid, the boxes of what else in the view meets its box: the other
+/// solids' polygons and the polygons of `m` that are not wide backgrounds (`behind`).
+fn met_by(solids: &[WholeSolid], m: &Mapped, behind: &[bool]) -> Vec<Vec<(DVec2, DVec2)>> {
     let Some(all) = solids.iter().map(|w| w.bounds).reduce(box_union) else { return Vec::new() };
     let mut grid = BoxGrid::new(all, 4 * solids.len());
     for (k, w) in solids.iter().enumerate() {
         grid.add(k as u32, w.bounds);
     }
-    let met: Vec<AtomicBool> = solids.iter().map(|_| AtomicBool::new(false)).collect();
-    // Marks the solids (but `own`) whose boxes meet `b`.
-    let meet = |b: (DVec2, DVec2), own: Option<u32>| {
-        for c in grid.cells(b) {
-            for &k in grid.cells[c].iter().filter(|&&k| Some(k) != own) {
-                if boxes_meet(b, solids[k as usize].bounds) {
-                    met[k as usize].store(true, Relaxed);
-                }
-            }
-        }
+    // The solids (but `own`) whose boxes meet `b`.
+    let meeting = |b: (DVec2, DVec2), own: Option<u32>| {
+        let mut found: Vec<u32> = grid
+            .cells(b)
+            .flat_map(|c| grid.cells[c].iter().copied())
+            .filter(|&k| Some(k) != own && boxes_meet(b, solids[k as usize].bounds))
+            .collect();
+        found.sort_unstable();
+        found.dedup();
+        found
     };
-    solids.par_iter().enumerate().for_each(|(k, w)| meet(w.bounds, Some(k as u32)));
     let polygons = m.polys.par_iter().zip(behind).filter(|&(p, &b)| !b && boxes_meet(p.bounds, all));
-    polygons.for_each(|(p, _)| meet(p.bounds, None));
-    met.into_iter().map(|f| !f.into_inner()).collect()
+    let mut pairs: Vec<(u32, (DVec2, DVec2))> =
+        polygons.flat_map_iter(|(p, _)| meeting(p.bounds, None).into_iter().map(move |k| (k, p.bounds))).collect();
+    pairs.par_sort_unstable_by(|a, b| a.0.cmp(&b.0));
+    (0..solids.len())
+        .into_par_iter()
+        .map(|k| {
+            let w = &solids[k];
+            let of_k = pairs.partition_point(|p| p.0 < k as u32)..pairs.partition_point(|p| p.0 <= k as u32);
+            let mut met: Vec<(DVec2, DVec2)> = pairs[of_k].iter().map(|p| p.1).collect();
+            for j in meeting(w.bounds, Some(k as u32)) {
+                let other = solids[j as usize].corners.iter().map(corner_box);
+                met.extend(other.filter(|&b| boxes_meet(b, w.bounds)));
+            }
+            met
+        })
+        .collect()
 }
 
 /// The places among `kept` (indices into `m.polys`) of the sheet polygons (`sheet`), by the

@@ -158,11 +158,11 @@ pub struct AthertonWeilerGreenbergOptions {
     /// another) on a grid, without testing pairs, and are wholly lit. `false` sorts them with
     /// the rest, as the paper does.
     pub lone_sheets: bool,
-    /// With `lone_sheets`, settle a closed solid's whole side facing the light at once where
-    /// it lies in one light view (default true; ours): its outline there is found from the
-    /// edges it turns to the light, and where nothing else meets its box, its polygons are
-    /// wholly lit without being mapped one by one. `false` takes every polygon through the
-    /// lone-sheet step alone.
+    /// With `lone_sheets`, settle a closed solid's side facing the light at once where it
+    /// lies in one light view (default true; ours): only its corners are mapped, its outline
+    /// there is found from the edges it turns to the light, and its polygons whose boxes
+    /// meet nothing else are wholly lit without being mapped one by one. `false` takes every
+    /// polygon through the lone-sheet step alone.
     pub whole_solids: bool,
     /// Leave out of each light view the polygons of closed solids that cast shadows and turn
     /// away from the light (default true; ours, the solid cull of
