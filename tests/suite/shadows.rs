@@ -498,6 +498,61 @@ fn solid_outlines_count_what_each_polygon_counted() {
     assert!(in_shadow > 40 * 300, "only {in_shadow} pixels in shadow");
 }
 
+/// Random spheres on a floor, for the tests of closed solids below: `count` of them, their
+/// radii in `radius`, their centres `lift` radii above the floor (some sink through it where
+/// `lift` starts below 1) and within `spread` of its middle.
+struct Spheres {
+    count: u64,
+    radius: (f64, f64),
+    lift: (f64, f64),
+    spread: f64,
+}
+
+impl Spheres {
+    /// The scene of `seed`: a 12 × 12 floor under the spheres (geodesic and UV, every third
+    /// dented, its cap pushed in so that the solid's polygons round the dent face each
+    /// other, every fifth wound the other way), seen at 80 × 60 from a random eye, lit by a
+    /// directional light where `kind % 4` is 3, else by a point light just above the first
+    /// sphere's centre (inside its bounds) where `inside`, else by one from all round.
+    fn on_a_floor(&self, seed: u64, kind: u64, inside: bool) -> Scene {
+        use rand::{Rng, SeedableRng};
+        use umbra::generate::{geodesic_sphere, sphere_mesh};
+        use umbra::{Camera, Light, Material, Mesh, Object};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut v = |lo: f64, hi: f64| rng.gen_range(lo..hi);
+        let eye = glam::DVec3::new(v(-6.0, 6.0), v(1.0, 8.0), v(-6.0, 6.0));
+        let mut b = Scene::builder(Camera { width: 80, height: 60, near: 0.05, ..Camera::new(eye, glam::DVec3::ZERO) })
+            .material(Material::new("m"));
+        let floor = [(-6.0, -6.0), (-6.0, 6.0), (6.0, 6.0), (6.0, -6.0)].map(|(x, z)| glam::DVec3::new(x, 0.0, z));
+        b = b.object(Object::new(Mesh::from_polygons(&[floor.to_vec()])), "m");
+        let mut centres = Vec::new();
+        for k in 0..self.count {
+            let r = v(self.radius.0, self.radius.1);
+            let c = glam::DVec3::new(
+                v(-self.spread, self.spread),
+                r * v(self.lift.0, self.lift.1),
+                v(-self.spread, self.spread),
+            );
+            centres.push(c);
+            let mut mesh = if (kind + k).is_multiple_of(2) { geodesic_sphere(c, r, 2) } else { sphere_mesh(c, r, 300) };
+            if (kind + k).is_multiple_of(3) {
+                let top = c.y + 0.3 * r;
+                mesh.positions.iter_mut().filter(|p| p.y > top).for_each(|p| p.y = top - 0.6 * (p.y - top));
+            }
+            if (kind + k).is_multiple_of(5) {
+                mesh.faces.iter_mut().for_each(|f| f.vertices.reverse());
+            }
+            b = b.object(Object::new(mesh), "m");
+        }
+        let light = match kind % 4 {
+            3 => Light::directional(glam::DVec3::new(v(-1.0, 1.0), -1.0, v(-1.0, 1.0))),
+            _ if inside => Light::point(centres[0] + glam::DVec3::new(0.05, 0.3, -0.02)),
+            _ => Light::point(glam::DVec3::new(v(-5.0, 5.0), v(2.0, 9.0), v(-5.0, 5.0))),
+        };
+        b.light(light).build().unwrap()
+    }
+}
+
 /// Bouknight-Kelley takes, of a receiver's own closed solid, only its front set (`own_solid`,
 /// ours): on random floors under UV and geodesic spheres and dented ones (a cap pushed in,
 /// so not convex), wound either way, lit by point lights from all round (inside a solid's
@@ -506,42 +561,12 @@ fn solid_outlines_count_what_each_polygon_counted() {
 /// is at work on every scene, and leaves fewer pairs to the behind test.
 #[test]
 fn own_solid_front_sets_keep_what_the_behind_test_keeps() {
-    use rand::{Rng, SeedableRng};
-    use umbra::generate::{geodesic_sphere, sphere_mesh};
     use umbra::shadow::BouknightKelleyOptions;
-    use umbra::{Camera, Counter, Light, Material, Mesh, Object};
+    use umbra::Counter;
     let mut in_shadow = 0;
     for seed in 0..24u64 {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(500 + seed);
-        let mut v = |lo: f64, hi: f64| rng.gen_range(lo..hi);
-        let eye = glam::DVec3::new(v(-6.0, 6.0), v(1.0, 8.0), v(-6.0, 6.0));
-        let mut b = Scene::builder(Camera { width: 80, height: 60, near: 0.05, ..Camera::new(eye, glam::DVec3::ZERO) })
-            .material(Material::new("m"));
-        let floor = [(-6.0, -6.0), (-6.0, 6.0), (6.0, 6.0), (6.0, -6.0)].map(|(x, z)| glam::DVec3::new(x, 0.0, z));
-        b = b.object(Object::new(Mesh::from_polygons(&[floor.to_vec()])), "m");
-        let mut centres = Vec::new();
-        for k in 0..3 {
-            let r = v(0.4, 1.0);
-            let c = glam::DVec3::new(v(-3.0, 3.0), r * v(0.8, 2.0), v(-3.0, 3.0));
-            centres.push(c);
-            let mut mesh = if (seed + k) % 2 == 0 { geodesic_sphere(c, r, 2) } else { sphere_mesh(c, r, 300) };
-            if (seed + k) % 3 == 0 {
-                // A cap pushed in: the solid's polygons round the dent face each other.
-                let top = c.y + 0.3 * r;
-                mesh.positions.iter_mut().filter(|p| p.y > top).for_each(|p| p.y = top - 0.6 * (p.y - top));
-            }
-            if (seed + k) % 5 == 0 {
-                mesh.faces.iter_mut().for_each(|f| f.vertices.reverse());
-            }
-            b = b.object(Object::new(mesh), "m");
-        }
-        let light = match seed % 4 {
-            3 => Light::directional(glam::DVec3::new(v(-1.0, 1.0), -1.0, v(-1.0, 1.0))),
-            // Above a sphere's centre, inside its bounds.
-            2 => Light::point(centres[0] + glam::DVec3::new(0.05, 0.3, -0.02)),
-            _ => Light::point(glam::DVec3::new(v(-5.0, 5.0), v(2.0, 9.0), v(-5.0, 5.0))),
-        };
-        let scene = b.light(light).build().unwrap();
+        let spheres = Spheres { count: 3, radius: (0.4, 1.0), lift: (0.8, 2.0), spread: 3.0 };
+        let scene = spheres.on_a_floor(500 + seed, seed, seed % 4 == 2);
         for sphere_grid in [true, false] {
             let opts = |own_solid| umbra::RenderOptions {
                 shadows: ShadowMethod::BouknightKelley(BouknightKelleyOptions {
@@ -582,43 +607,13 @@ fn own_solid_front_sets_keep_what_the_behind_test_keeps() {
 /// it; whole solids are settled on most scenes, and none without the step.
 #[test]
 fn whole_solids_settle_what_their_polygons_would() {
-    use rand::{Rng, SeedableRng};
-    use umbra::generate::{geodesic_sphere, sphere_mesh};
     use umbra::shadow::AthertonWeilerGreenbergOptions;
-    use umbra::{Camera, Counter, Light, Material, Mesh, Object};
+    use umbra::Counter;
     let (mut settled, mut scenes_settled, mut in_shadow) = (0, 0, 0);
     for seed in 0..32u64 {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(900 + seed);
-        let mut v = |lo: f64, hi: f64| rng.gen_range(lo..hi);
-        let eye = glam::DVec3::new(v(-6.0, 6.0), v(1.0, 8.0), v(-6.0, 6.0));
-        let mut b = Scene::builder(Camera { width: 80, height: 60, near: 0.05, ..Camera::new(eye, glam::DVec3::ZERO) })
-            .material(Material::new("m"));
-        let floor = [(-6.0, -6.0), (-6.0, 6.0), (6.0, 6.0), (6.0, -6.0)].map(|(x, z)| glam::DVec3::new(x, 0.0, z));
-        b = b.object(Object::new(Mesh::from_polygons(&[floor.to_vec()])), "m");
-        let mut centres = Vec::new();
-        for k in 0..4 {
-            let r = v(0.3, 0.9);
-            // Most rest above the floor; some sink through its plane.
-            let c = glam::DVec3::new(v(-2.5, 2.5), r * v(0.6, 2.5), v(-2.5, 2.5));
-            centres.push(c);
-            let mut mesh = if (seed + k) % 2 == 0 { geodesic_sphere(c, r, 2) } else { sphere_mesh(c, r, 300) };
-            if (seed + k) % 3 == 0 {
-                // A cap pushed in: seen from above, the front folds over itself.
-                let top = c.y + 0.3 * r;
-                mesh.positions.iter_mut().filter(|p| p.y > top).for_each(|p| p.y = top - 0.6 * (p.y - top));
-            }
-            if (seed + k) % 5 == 0 {
-                mesh.faces.iter_mut().for_each(|f| f.vertices.reverse());
-            }
-            b = b.object(Object::new(mesh), "m");
-        }
-        let light = match seed % 4 {
-            3 => Light::directional(glam::DVec3::new(v(-1.0, 1.0), -1.0, v(-1.0, 1.0))),
-            // Above a sphere's centre, inside its bounds.
-            2 if seed % 8 == 2 => Light::point(centres[0] + glam::DVec3::new(0.05, 0.3, -0.02)),
-            _ => Light::point(glam::DVec3::new(v(-5.0, 5.0), v(2.0, 9.0), v(-5.0, 5.0))),
-        };
-        let scene = b.light(light).build().unwrap();
+        // Most rest above the floor; some sink through its plane.
+        let spheres = Spheres { count: 4, radius: (0.3, 0.9), lift: (0.6, 2.5), spread: 2.5 };
+        let scene = spheres.on_a_floor(900 + seed, seed, seed % 8 == 2);
         let face_binning = seed % 5 != 4;
         let opts = |whole_solids| umbra::RenderOptions {
             shadows: ShadowMethod::AthertonWeilerGreenberg(AthertonWeilerGreenbergOptions {
