@@ -913,8 +913,15 @@ impl Scene {
     /// `docs/algorithms/bouknight-kelley.md`, "Speed-ups that are ours", and
     /// `docs/algorithms/scanline.md`.
     pub(crate) fn turned_away_on_solid(&self, i: usize, from: LightSample, closed: &[bool]) -> bool {
+        self.turned_away_at(i, from.side_of(&self.polygons[i].plane), closed)
+    }
+
+    /// [`Scene::turned_away_on_solid`], given `side`, `from`'s side of polygon `i`'s plane
+    /// ([`LightSample::side_of`]).
+    #[inline]
+    pub(crate) fn turned_away_at(&self, i: usize, side: f64, closed: &[bool]) -> bool {
         let s = self.solid_of[i] as usize;
-        closed.get(s) == Some(&true) && from.side_of(&self.polygons[i].plane) * self.solids[s].sign < 0.0
+        closed.get(s) == Some(&true) && side * self.solids[s].sign < 0.0
     }
 
     /// Whether polygon `i` is one piece of a non-planar face split into a fan (its face has

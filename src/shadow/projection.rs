@@ -19,10 +19,16 @@ pub fn light_side(plane: &Plane, sample: LightSample) -> f64 {
 
 /// Whether the light lies in polygon `i`'s plane (to a relative 1e-12): its shadow has no area.
 pub fn edge_on(scene: &Scene, i: usize, sample: LightSample, extent: f64) -> bool {
-    let plane = &scene.polygons[i].plane;
+    sample.side_of(&scene.polygons[i].plane).abs() <= edge_on_below(sample, extent)
+}
+
+/// The size of [`LightSample::side_of`] at or below which the light lies in a plane
+/// ([`edge_on`]) in a scene `extent` across: a distance of `1e-12 * extent` from a point
+/// light, a cosine of `1e-12` with a directional light's direction.
+fn edge_on_below(sample: LightSample, extent: f64) -> f64 {
     match sample {
-        LightSample::Point(s) => plane.distance(s).abs() <= 1e-12 * extent,
-        LightSample::Directional(d) => plane.n.dot(d).abs() <= 1e-12,
+        LightSample::Point(_) => 1e-12 * extent,
+        LightSample::Directional(_) => 1e-12,
     }
 }
 
@@ -45,9 +51,14 @@ pub(crate) fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample, 
 pub fn unseen(scene: &Scene, sample: LightSample, extent: f64, cull: bool) -> Vec<bool> {
     use rayon::prelude::*;
     let closed = if cull { scene.closed_from(sample) } else { Vec::new() };
+    let below = edge_on_below(sample, extent);
+    // The light's side of each plane is found once for both tests.
     (0..scene.polygons.len())
         .into_par_iter()
-        .map(|i| edge_on(scene, i, sample, extent) || faces_away_on_solid(scene, i, sample, &closed))
+        .map(|i| {
+            let side = sample.side_of(&scene.polygons[i].plane);
+            side.abs() <= below || (scene.casts_shadows(i) && scene.turned_away_at(i, side, &closed))
+        })
         .collect()
 }
 
