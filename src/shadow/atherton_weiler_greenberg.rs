@@ -2172,4 +2172,53 @@ mod tests {
         }
         assert!(undecided > 10_000 && decided > 50_000, "{decided} decided, {undecided} not");
     }
+
+    /// A sphere lit from one side is offered whole in the view that holds it, every
+    /// polygon facing the light in it; the same sphere with its cap pushed in, lit from the
+    /// side, turns the dent's far wall to the light behind its near rim, so that its front
+    /// folds over itself in the view, and is not offered.
+    #[test]
+    fn a_front_that_folds_over_itself_is_not_offered_whole() {
+        use crate::scene::{Camera, Light, Material, Object};
+        let offered = |dent: bool| {
+            let centre = DVec3::new(0.0, 1.0, 0.0);
+            let mut mesh = crate::generate::geodesic_sphere(centre, 1.0, 3);
+            if dent {
+                let top = centre.y + 0.3;
+                mesh.positions.iter_mut().filter(|p| p.y > top).for_each(|p| p.y = top - 0.6 * (p.y - top));
+            }
+            let camera = Camera { width: 32, height: 24, ..Camera::new(DVec3::new(0.0, 3.0, 6.0), centre) };
+            let light = DVec3::new(-4.0, 3.5, 0.5);
+            let scene = Scene::builder(camera)
+                .material(Material::new("m"))
+                .object(Object::new(mesh), "m")
+                .light(Light::point(light))
+                .build()
+                .unwrap();
+            let sample = LightSample::Point(light);
+            let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
+            let unseen = unseen(&scene, sample, extent, true);
+            let face = cube_faces(&scene, sample, &unseen);
+            let members = scene.solid_members();
+            let of = SampleSolids {
+                sample,
+                unseen: &unseen,
+                face: &face,
+                closed: scene.closed_from(sample),
+                members: &members,
+            };
+            let facing = unseen.iter().filter(|&&u| !u).count();
+            let views = LightView::views(sample);
+            let found: Vec<WholeSolid> = views
+                .iter()
+                .enumerate()
+                .flat_map(|(v, view)| whole_solids(&scene, view, v as u8, &of, extent))
+                .collect();
+            (found.iter().map(|w| w.polygons.len()).collect::<Vec<_>>(), facing)
+        };
+        let (whole, facing) = offered(false);
+        assert_eq!(whole, vec![facing], "the sphere's {facing} polygons facing the light");
+        let (dented, facing) = offered(true);
+        assert!(dented.is_empty() && facing > 100, "{dented:?} offered of {facing} facing the light");
+    }
 }
