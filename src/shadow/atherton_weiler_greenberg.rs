@@ -1850,15 +1850,15 @@ fn lit_fragments(
     let extent = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-300));
     let t = Instant::now();
     let mut done: Vec<(usize, Vec<Lit>, Pass1)> = Vec::new();
-    let whole_solids = options.lone_sheets && options.whole_solids && !scene.solids.is_empty();
-    let members = if whole_solids { scene.solid_members() } else { Vec::new() };
+    let offer_solids = options.lone_sheets && options.whole_solids && !scene.solids.is_empty();
+    let members = if offer_solids { scene.solid_members() } else { Vec::new() };
     for (s, sample) in l.samples().into_iter().enumerate() {
         let unseen = unseen(scene, sample, extent, options.solid_cull);
         // A polygon wholly inside one cube face is mapped into that face alone.
         let face = if options.face_binning { cube_faces(scene, sample, &unseen) } else { Vec::new() };
         let views = LightView::views(sample);
         let seen = view_lists(&face, &unseen, views.len());
-        let closed = if whole_solids { scene.closed_from(sample) } else { Vec::new() };
+        let closed = if offer_solids { scene.closed_from(sample) } else { Vec::new() };
         let solids = SampleSolids { sample, unseen: &unseen, face: &face, closed, members: &members };
         let views: Vec<(Vec<Lit>, Pass1)> = views
             .into_par_iter()
@@ -1867,7 +1867,7 @@ fn lit_fragments(
             .map(|(v, (view, seen))| {
                 let mut stats = Pass1::new(options);
                 let whole =
-                    if whole_solids { self::whole_solids(scene, &view, v as u8, &solids, extent) } else { Vec::new() };
+                    if offer_solids { whole_solids(scene, &view, v as u8, &solids, extent) } else { Vec::new() };
                 let lit = lit_in_view(scene, seen, view, whole, extent, &mut stats).map_err(clip_error)?;
                 Ok((lit, stats))
             })
