@@ -435,10 +435,8 @@ impl View {
     /// far plane clips the farther of the two first.)
     pub(crate) fn solids_past_near_plane(&self, scene: &Scene) -> Vec<bool> {
         let depth = |p: DVec3| (p - self.eye).dot(self.f);
-        let corners = |lo: DVec3, hi: DVec3| {
-            (0..8).map(move |k| DVec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo))
-        };
-        scene.solids.iter().map(|s| corners(s.lo, s.hi).all(|c| depth(c) > self.near)).collect()
+        let corners = |s: &crate::scene::Solid| crate::geometry::box_corners(s.lo, s.hi);
+        scene.solids.iter().map(|s| corners(s).iter().all(|&c| depth(c) > self.near)).collect()
     }
 
     /// Every polygon of the scene that survives clipping, in screen space.

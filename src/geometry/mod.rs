@@ -257,6 +257,12 @@ pub(crate) fn grid_rectangle(
     (c0, c1, r0, r1)
 }
 
+/// The eight corners of the box `lo..hi`: corner `k` takes `hi` in x, y and z where bits 0,
+/// 1 and 2 of `k` are set.
+pub(crate) fn box_corners(lo: DVec3, hi: DVec3) -> [DVec3; 8] {
+    std::array::from_fn(|k| DVec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2]))
+}
+
 /// Directed edges, given by the keys of their ends, chained into closed loops (each a list
 /// of edge indices in order); `None` when a key starts two edges or an edge leads nowhere.
 pub(crate) fn edge_loops<K: Eq + std::hash::Hash + Copy>(ends: &[(K, K)]) -> Option<Vec<Vec<usize>>> {

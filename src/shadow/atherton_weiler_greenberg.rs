@@ -30,7 +30,7 @@ use crate::error::{Error, Result};
 use crate::geometry::convex_split::{self, is_convex};
 use crate::geometry::lone_sheets::{self, Item, NO_ITEM};
 use crate::geometry::weiler_atherton::{clip, regions_apart, ring_bounds, signed_area, ClipError, Region, Ring};
-use crate::geometry::{clip_in_place, clip_polygon, even_odd, grid_cells, simple, Plane};
+use crate::geometry::{box_corners, clip_in_place, clip_polygon, even_odd, grid_cells, simple, Plane};
 use crate::pieces;
 use crate::scene::{LightSample, ObjText, Scene};
 use crate::stats::Counters;
@@ -777,12 +777,7 @@ impl LightView {
     /// its near plane (never, for a parallel view).
     fn misses_box(&self, (lo, hi): (DVec3, DVec3), near: f64) -> bool {
         let LightView::Face { light, axis, e1, e2 } = *self else { return false };
-        let corner = |k: usize| {
-            let pick = |bit: usize, a: f64, b: f64| if k & bit == 0 { a } else { b };
-            DVec3::new(pick(1, lo.x, hi.x), pick(2, lo.y, hi.y), pick(4, lo.z, hi.z))
-        };
-        let sides: Vec<[f64; 5]> =
-            (0..8).map(|k| face_sides(face_frame(corner(k) - light, e1, e2, axis), near)).collect();
+        let sides = box_corners(lo, hi).map(|c| face_sides(face_frame(c - light, e1, e2, axis), near));
         (0..5).any(|side| sides.iter().all(|s| s[side] < 0.0))
     }
 
@@ -1152,11 +1147,7 @@ impl WholeSolid {
         let (lo, hi) = self.world;
         let side = self.sample.side_of(plane);
         let side = if side == 0.0 { return false } else { side.signum() };
-        (0..8).all(|k: usize| {
-            let pick = |bit: usize, a: f64, b: f64| if k & bit == 0 { a } else { b };
-            let c = DVec3::new(pick(1, lo.x, hi.x), pick(2, lo.y, hi.y), pick(4, lo.z, hi.z));
-            plane.distance(c) * side > margin
-        })
+        box_corners(lo, hi).iter().all(|&c| plane.distance(c) * side > margin)
     }
 }
 

@@ -115,8 +115,7 @@ impl Target {
     /// (a relative 1e-9) that rounding cannot cross: then [`Target::misses`] holds for every
     /// polygon whose corners lie in the box (ours: a whole piece of polygons is passed over).
     pub fn misses_box(&self, (lo, hi): (DVec3, DVec3)) -> bool {
-        let corners = [0, 1, 2, 3, 4, 5, 6, 7]
-            .map(|k| DVec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo));
+        let corners = crate::geometry::box_corners(lo, hi);
         self.pyramid.iter().any(|&(origin, m)| {
             let reach = corners.iter().map(|&c| (c - origin).length()).fold(0.0, f64::max) + origin.length();
             let margin = 1e-9 * m.length() * reach;

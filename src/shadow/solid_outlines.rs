@@ -116,13 +116,7 @@ impl SolidOutlines {
     /// `margin`, and the box's shadow on the plane whole on screen.
     pub(crate) fn fits(&self, scene: &Scene, s: u32, target: &Target, view: &View, margin: f64) -> bool {
         let solid = &scene.solids[s as usize];
-        let corners: [DVec3; 8] = std::array::from_fn(|k| {
-            DVec3::new(
-                if k & 1 == 0 { solid.lo.x } else { solid.hi.x },
-                if k & 2 == 0 { solid.lo.y } else { solid.hi.y },
-                if k & 4 == 0 { solid.lo.z } else { solid.hi.z },
-            )
-        });
+        let corners = crate::geometry::box_corners(solid.lo, solid.hi);
         let (plane, side) = (&target.plane, target.side);
         let between = corners.iter().all(|&c| {
             let before = plane.distance(c) * side > margin;

@@ -50,7 +50,7 @@
 use super::far_outline::{self, FarEdge};
 use super::projection::{light_side, unseen, Projector, Target};
 use super::ShadowContext;
-use crate::geometry::{dominant_axis, drop_axis, even_odd, newell_normal, Plane, RingPieces, Rings};
+use crate::geometry::{box_corners, dominant_axis, drop_axis, even_odd, newell_normal, Plane, RingPieces, Rings};
 use crate::pieces::joined;
 use crate::pool::Stash;
 use crate::scene::LightSample;
@@ -1026,7 +1026,7 @@ impl FarPlane {
         // Every sight line through the bounds meets the plane within the hull of the
         // corners' shadows from the eye on it.
         let (mut a, mut b) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for c in corners(lo, hi) {
+        for c in box_corners(lo, hi) {
             let q = eye + (c - eye) * ((at - eye[axis]) / (c[axis] - eye[axis]));
             (a, b) = (a.min(q), b.max(q));
         }
@@ -1054,11 +1054,6 @@ fn margin((lo, hi): (DVec3, DVec3), eye: DVec3) -> f64 {
     1e-6 * ((hi - lo).length() + lo.abs().max(hi.abs()).max(eye.abs()).max_element())
 }
 
-/// The eight corners of the box `lo..hi`.
-fn corners(lo: DVec3, hi: DVec3) -> [DVec3; 8] {
-    std::array::from_fn(|k| DVec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2]))
-}
-
 /// The region every sight line a count follows stays in (ours), which the sides are cut to.
 /// For z-pass, the convex hull of the eye and the scene's bounds, grown by a margin: a
 /// z-pass count at a visible point P sums the shadow polygons crossed between the eye (its
@@ -1082,7 +1077,7 @@ impl SightHull {
     /// planes only make the region larger, never wrong).
     pub(crate) fn new(bounds: (DVec3, DVec3), eye: DVec3) -> Self {
         let (lo, hi) = grown(bounds, eye);
-        let corners = corners(lo, hi);
+        let corners = box_corners(lo, hi);
         // The six faces, inward: (axis, coordinate, inward normal, offset).
         let faces: Vec<(usize, f64, DVec3, f64)> = (0..3)
             .flat_map(|i| {
