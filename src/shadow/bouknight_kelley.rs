@@ -38,7 +38,7 @@
 use super::far_outline::{self, FarEdge};
 use super::overlay::{Interval, Overlay, OverlayWalker, ReceiverTable};
 use super::own_solid::{Own, OwnSolid};
-use super::projection::{bounding_rectangle, edge_on, faces_away_on_solid, light_side, Projector, Target};
+use super::projection::{self, bounding_rectangle, light_side, Projector, Target};
 use super::solid_outlines::{self, SolidOutlines};
 use super::{
     BouknightKelleyOptions, Cover, Decision, Detail, Outcome, Segment, ShadowContext, ShadowStage, ShadowWalker,
@@ -110,12 +110,7 @@ fn shadow_polygons(
         .into_par_iter()
         .filter(|&i| seen(i as usize) && sample.on_seen_side(&scene.polygons[i as usize].plane, ctx.view.eye))
         .collect();
-    let casting = |i: usize| scene.casts_shadows(i) && !edge_on(scene, i, sample, ctx.extent);
-    let closed = scene.closed_from(sample);
-    let (casters, dropped): (Vec<u32>, Vec<u32>) = (0..n as u32)
-        .into_par_iter()
-        .filter(|&i| casting(i as usize))
-        .partition(|&i| !(options.solid_cull && faces_away_on_solid(scene, i as usize, sample, &closed)));
+    let (casters, dropped) = projection::casters(scene, sample, ctx.extent, options.solid_cull);
     if options.solid_cull {
         counters.add(crate::stats::Counter::CastersDroppedFacingAway, dropped.len() as u64);
     }

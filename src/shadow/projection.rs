@@ -32,22 +32,11 @@ fn edge_on_below(sample: LightSample, extent: f64) -> f64 {
     }
 }
 
-/// Whether polygon `i` belongs to a closed solid that casts shadows, faces away from the light
-/// sample, and the sample lies outside the solid's bounds: such a polygon never needs to
-/// cast, since a shadow ray that crosses it has crossed, nearer the light, a polygon of the
-/// same solid that faces the light ([`Scene::turned_away_on_solid`]), and is never lit, for
-/// the same reason. A solid that casts no shadow hides nothing, so its polygons turned away
-/// are lit through it (`tests/data/awg-area/wrong_120218.toml`, an inward-wound icosahedron
-/// that casts none).
-pub(crate) fn faces_away_on_solid(scene: &Scene, i: usize, sample: LightSample, closed: &[bool]) -> bool {
-    scene.casts_shadows(i) && scene.turned_away_on_solid(i, sample, closed)
-}
-
 /// `unseen[i]`: whether light sample `sample` need not consider polygon `i`, found in
 /// parallel: the light lies in its plane ([`edge_on`]: no lit area, no shadow), or, with
-/// `cull`, it is a closed solid's polygon turned away from the light
-/// ([`faces_away_on_solid`]: unlit, and it hides nothing its solid's polygons turned to the
-/// light do not; ours, not the papers').
+/// `cull`, it is a polygon of a closed solid that casts shadows, turned away from the light
+/// ([`casters`]: unlit, and it hides nothing its solid's polygons turned to the light do
+/// not; ours, not the papers').
 pub fn unseen(scene: &Scene, sample: LightSample, extent: f64, cull: bool) -> Vec<bool> {
     use rayon::prelude::*;
     let closed = if cull { scene.closed_from(sample) } else { Vec::new() };
@@ -60,6 +49,31 @@ pub fn unseen(scene: &Scene, sample: LightSample, extent: f64, cull: bool) -> Ve
             side.abs() <= below || (scene.casts_shadows(i) && scene.turned_away_at(i, side, &closed))
         })
         .collect()
+}
+
+/// The polygons that cast shadows for light sample `sample` and do not lie edge-on to it
+/// ([`edge_on`]), in increasing order, split in two: where `cull` is set, those of a closed
+/// solid turned away from the light, the sample outside the solid's bounds
+/// ([`Scene::turned_away_on_solid`]); and the others. Returns `(kept, turned away)`.
+///
+/// A polygon turned away never needs to cast: a shadow ray that crosses it has crossed,
+/// nearer the light, a polygon of the same solid that faces the light; and it is never lit,
+/// for the same reason. A solid that casts no shadow hides nothing, so its polygons turned
+/// away are lit through it (`tests/data/awg-area/wrong_120218.toml`, an inward-wound
+/// icosahedron that casts none); they are not casters here. The light's side of each plane
+/// is found once for both tests (ours).
+pub(crate) fn casters(scene: &Scene, sample: LightSample, extent: f64, cull: bool) -> (Vec<u32>, Vec<u32>) {
+    use rayon::iter::Either;
+    use rayon::prelude::*;
+    let closed = if cull { scene.closed_from(sample) } else { Vec::new() };
+    let below = edge_on_below(sample, extent);
+    (0..scene.polygons.len() as u32)
+        .into_par_iter()
+        .filter_map(|i| {
+            let side = scene.casts_shadows(i as usize).then(|| sample.side_of(&scene.polygons[i as usize].plane))?;
+            (side.abs() > below).then(|| (i, scene.turned_away_at(i as usize, side, &closed)))
+        })
+        .partition_map(|(i, away)| if away { Either::Right(i) } else { Either::Left(i) })
 }
 
 /// A bounded piece of a plane that polygons are projected onto from one light sample: the
