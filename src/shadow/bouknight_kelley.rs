@@ -550,6 +550,10 @@ struct Wedge {
 
 impl Wedge {
     /// The wedge of receiver `verts`, when it is a triangle the light does not see edge-on.
+    /// Inlined, as [`Wedge::misses`] is, into the loop over a receiver's casters (ours: as
+    /// calls, the 224-byte wedge was returned through memory and each test was a call;
+    /// inlined, s3's preparation takes 1.4% fewer instructions).
+    #[inline(always)]
     fn of(verts: &[DVec3], sample: LightSample, extent: f64) -> Option<Wedge> {
         let [a, b, c] = verts else { return None };
         let plane = |p: DVec3, q: DVec3, opposite: DVec3| {
@@ -568,6 +572,7 @@ impl Wedge {
     /// Whether every corner of `verts` lies outside one and the same plane of the wedge, or
     /// is a corner of the receiver's edge on that plane (which lies on the plane exactly: a
     /// neighbour across that edge is seen from the light beside the receiver too).
+    #[inline(always)]
     fn misses(&self, verts: &[DVec3]) -> bool {
         self.planes.iter().any(|&(n, p, q)| verts.iter().all(|&v| n.dot(v - p) > self.margin || v == p || v == q))
     }
